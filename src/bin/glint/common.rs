@@ -1,0 +1,50 @@
+//! Pieces shared by the subcommands.
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use glint::scene::Scene;
+
+/// `on` / `off`, as the command line spells a switch.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Switch {
+    On,
+    Off,
+}
+
+impl Switch {
+    pub fn is_on(self) -> bool {
+        self == Switch::On
+    }
+}
+
+/// Loads a scene and reports how long it took.
+pub fn load_scene(path: &Path) -> Result<(Scene, f64)> {
+    let start = Instant::now();
+    let scene = glint::scene::load(path)?;
+    Ok((scene, start.elapsed().as_secs_f64()))
+}
+
+/// A rayon pool with `threads` workers (0 = one per core).
+pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("cannot start the render threads")
+}
+
+pub fn parse_samples(s: &str) -> std::result::Result<u32, String> {
+    match s {
+        "1" => Ok(1),
+        "16" => Ok(16),
+        _ => Err(format!("samples must be 1 or 16, got `{s}`")),
+    }
+}
+
+pub fn parse_positive(s: &str) -> std::result::Result<u32, String> {
+    match s.parse::<u32>() {
+        Ok(n) if n > 0 => Ok(n),
+        _ => Err(format!("expected a whole number of at least 1, got `{s}`")),
+    }
+}

@@ -1,0 +1,50 @@
+//! The `glint` command: headless rendering and benchmarks (and, with the
+//! `gui` feature, the interactive viewer).
+
+mod bench;
+mod common;
+mod render_cmd;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(
+    name = "glint",
+    version,
+    about = "An interactive Whitted-style ray tracer"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene (TOML or NFF) to a PNG file.
+    Render(render_cmd::RenderArgs),
+    /// Time scenes with the octree on and off, interleaved, and report medians.
+    Bench(bench::BenchArgs),
+}
+
+fn main() -> std::process::ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Some(Command::Render(args)) => render_cmd::run(&args),
+        Some(Command::Bench(args)) => bench::run(&args),
+        None => {
+            use clap::CommandFactory;
+            eprintln!(
+                "glint was built without the viewer (cargo feature `gui`); use a subcommand.\n"
+            );
+            let _ = Cli::command().print_help();
+            return std::process::ExitCode::from(2);
+        }
+    };
+    match result {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}

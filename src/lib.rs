@@ -1,0 +1,23 @@
+//! glint: a Whitted-style ray tracer. This library renders headless; the
+//! viewer (feature `gui`) and the command line are layers on top of it.
+//!
+//! ```no_run
+//! let scene = glint::scene::load(std::path::Path::new("scenes/spheres.toml"))?;
+//! let octree = glint::accel::Octree::build(&scene.shapes, scene.octree_params);
+//! let settings = glint::render::RenderSettings::from_scene(&scene);
+//! let renderer = glint::render::Renderer::new(&scene, &octree, settings)?;
+//! let (frame, _counts) = renderer.render(false, None);
+//! frame.save_png(std::path::Path::new("spheres.png"))?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+#![forbid(unsafe_code)]
+
+pub mod accel;
+pub mod camera;
+pub mod material;
+pub mod math;
+pub mod render;
+pub mod scene;
+pub mod shapes;
+pub mod stats;

@@ -1,0 +1,532 @@
+//! Whitted ray tracing of a scene into a linear-RGB frame.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use rayon::prelude::*;
+
+use crate::accel::{ClosestHit, Occlusion, Octree, closest_brute_force, occlusion_brute_force};
+use crate::camera::{Camera, CameraError, sample_offsets};
+use crate::math::{Color, DVec3, Ray, offset_ray_origin, reflect, refract};
+use crate::scene::Scene;
+use crate::shapes::PreparedRay;
+use crate::stats::{Counter, NoCounts, RayCounts, WorkCounts};
+
+/// What the image shows.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ViewMode {
+    /// Whitted shading (sRGB encoded on output).
+    #[default]
+    Shaded,
+    /// Geometric normal facing the camera as `(n + 1) / 2`, not sRGB encoded.
+    Normals,
+    /// Distance along the eye ray, nearest visible point white, farthest black.
+    Depth,
+}
+
+impl ViewMode {
+    pub const ALL: [ViewMode; 3] = [ViewMode::Shaded, ViewMode::Normals, ViewMode::Depth];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ViewMode::Shaded => "shaded",
+            ViewMode::Normals => "normals",
+            ViewMode::Depth => "depth",
+        }
+    }
+}
+
+impl std::str::FromStr for ViewMode {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|v| v.name() == s)
+            .ok_or_else(|| format!("unknown view `{s}` (expected shaded, normals or depth)"))
+    }
+}
+
+/// Everything that decides the image besides the scene; the command line
+/// and the viewer override the scene's own values.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct RenderSettings {
+    pub width: u32,
+    pub height: u32,
+    pub samples: u32,
+    pub max_depth: u32,
+    pub use_octree: bool,
+    pub view: ViewMode,
+}
+
+impl RenderSettings {
+    pub fn from_scene(scene: &Scene) -> Self {
+        Self {
+            width: scene.image.width,
+            height: scene.image.height,
+            samples: scene.image.samples,
+            max_depth: scene.image.max_depth,
+            use_octree: scene.octree_enabled,
+            view: ViewMode::Shaded,
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    #[error(transparent)]
+    Camera(#[from] CameraError),
+    #[error("samples must be 1 or 16, got {0}")]
+    Samples(u32),
+    #[error("max depth must be at least 1, got {0}")]
+    MaxDepth(u32),
+    #[error("image of {0}x{1} pixels is too large")]
+    TooLarge(u32, u32),
+}
+
+/// A rendered image: linear RGB for [`ViewMode::Shaded`] and
+/// [`ViewMode::Normals`]; for [`ViewMode::Depth`] the mean distance in `x`
+/// and the fraction of samples that hit in `y`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    pub width: u32,
+    pub height: u32,
+    pub view: ViewMode,
+    pub pixels: Vec<DVec3>,
+}
+
+/// Square tile edge in pixels: the unit of parallel work and of progress.
+pub const TILE: u32 = 16;
+
+/// A rectangle of pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Tile {
+    pub x: u32,
+    pub y: u32,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// Tiles covering a `width` x `height` image in row-major order.
+pub fn tiles(width: u32, height: u32) -> Vec<Tile> {
+    let mut out = Vec::new();
+    for y in (0..height).step_by(TILE as usize) {
+        for x in (0..width).step_by(TILE as usize) {
+            out.push(Tile {
+                x,
+                y,
+                width: TILE.min(width - x),
+                height: TILE.min(height - y),
+            });
+        }
+    }
+    out
+}
+
+/// Per-tile work, summed in tile order so totals never depend on threads.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TileCounts {
+    pub rays: RayCounts,
+    pub work: WorkCounts,
+    /// Samples whose colour came out NaN or infinite (then shown black).
+    /// Always zero unless something is wrong: tests assert it.
+    pub nonfinite_samples: u64,
+}
+
+impl std::ops::AddAssign for TileCounts {
+    fn add_assign(&mut self, o: Self) {
+        self.rays += o.rays;
+        self.work += o.work;
+        self.nonfinite_samples += o.nonfinite_samples;
+    }
+}
+
+/// A scene prepared for rendering with fixed settings.
+pub struct Renderer<'a> {
+    scene: &'a Scene,
+    octree: &'a Octree,
+    settings: RenderSettings,
+    camera: Camera,
+    offsets: Vec<(f64, f64)>,
+    is_transparent: Vec<bool>,
+    /// Magnitude of the scene's coordinates: the floor of ray offsets.
+    floor_scale: f64,
+}
+
+impl<'a> Renderer<'a> {
+    pub fn new(
+        scene: &'a Scene,
+        octree: &'a Octree,
+        settings: RenderSettings,
+    ) -> Result<Self, RenderError> {
+        if settings.samples != 1 && settings.samples != 16 {
+            return Err(RenderError::Samples(settings.samples));
+        }
+        if settings.max_depth == 0 {
+            return Err(RenderError::MaxDepth(settings.max_depth));
+        }
+        if settings.width as u64 * settings.height as u64 > 1 << 28 {
+            return Err(RenderError::TooLarge(settings.width, settings.height));
+        }
+        let camera = Camera::new(&scene.camera, settings.width, settings.height)?;
+        let is_transparent = scene
+            .shape_materials
+            .iter()
+            .map(|&m| scene.materials[m as usize].transparency > 0.0)
+            .collect();
+        Ok(Self {
+            scene,
+            octree,
+            settings,
+            camera,
+            offsets: sample_offsets(settings.samples),
+            is_transparent,
+            floor_scale: scene.extent_bounds().max_abs().max(f64::MIN_POSITIVE),
+        })
+    }
+
+    pub fn settings(&self) -> &RenderSettings {
+        &self.settings
+    }
+
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    fn closest<C: Counter>(&self, ray: &PreparedRay, counter: &mut C) -> Option<ClosestHit> {
+        if self.settings.use_octree {
+            self.octree
+                .closest(&self.scene.shapes, ray, f64::INFINITY, counter)
+        } else {
+            closest_brute_force(&self.scene.shapes, ray, f64::INFINITY, counter)
+        }
+    }
+
+    /// Fraction of light passing from `origin` to a light `distance` away.
+    fn transmittance<C: Counter>(&self, ray: &PreparedRay, distance: f64, counter: &mut C) -> f64 {
+        let occlusion = if self.settings.use_octree {
+            self.octree.occlusion(
+                &self.scene.shapes,
+                &self.is_transparent,
+                ray,
+                distance,
+                counter,
+            )
+        } else {
+            occlusion_brute_force(
+                &self.scene.shapes,
+                &self.is_transparent,
+                ray,
+                distance,
+                counter,
+            )
+        };
+        match occlusion {
+            Occlusion::Clear => 1.0,
+            Occlusion::Blocked => 0.0,
+            Occlusion::Transparent(mut shapes) => {
+                // A canonical order makes the product independent of the
+                // order the shapes were found in.
+                shapes.sort_unstable();
+                shapes.dedup();
+                shapes.iter().fold(1.0, |acc, &i| {
+                    let m = self.scene.shape_materials[i as usize] as usize;
+                    acc * self.scene.materials[m].transparency
+                })
+            }
+        }
+    }
+
+    /// Colour seen along `ray`, which is at recursion `depth` (eye ray = 1).
+    fn trace<C: Counter>(
+        &self,
+        ray: &Ray,
+        depth: u32,
+        counter: &mut C,
+        rays: &mut RayCounts,
+    ) -> Color {
+        let prepared = PreparedRay::new(*ray);
+        let Some(hit) = self.closest(&prepared, counter) else {
+            return self.scene.image.background;
+        };
+        if depth == 1 {
+            rays.primary_hits += 1;
+        }
+        let scene = self.scene;
+        let shape = &scene.shapes[hit.shape as usize];
+        let surface = shape.surface(ray, &hit.hit, &scene.vertex_normals);
+        let material = &scene.materials[scene.shape_materials[hit.shape as usize] as usize];
+        let entering = ray.dir.dot(surface.geometric_normal) < 0.0;
+        // Normals facing the incoming ray: glint's surfaces are two-sided.
+        let facing = if entering {
+            surface.geometric_normal
+        } else {
+            -surface.geometric_normal
+        };
+        let mut n = if surface.shading_normal.dot(facing) < 0.0 {
+            -surface.shading_normal
+        } else {
+            surface.shading_normal
+        };
+        if !n.is_finite() {
+            n = facing;
+        }
+        let view = -ray.dir;
+        let p = surface.point;
+
+        let mut color = material.ka * scene.image.ambient * material.color;
+        let shadow_origin = offset_ray_origin(p, facing, self.floor_scale);
+        for light in &scene.lights {
+            let to_light = light.position - shadow_origin;
+            let distance = to_light.length();
+            if !(distance > 0.0) {
+                continue;
+            }
+            let l = to_light / distance;
+            let n_dot_l = n.dot(l);
+            // A surface facing away from the light gets neither light nor a shadow ray.
+            if n_dot_l <= 0.0 || facing.dot(l) <= 0.0 {
+                continue;
+            }
+            rays.shadow += 1;
+            let shadow = PreparedRay::new(Ray::new(shadow_origin, l));
+            let pass = self.transmittance(&shadow, distance, counter);
+            if pass == 0.0 {
+                continue;
+            }
+            let diffuse = material.kd * n_dot_l * material.color;
+            let r = 2.0 * n_dot_l * n - l;
+            let specular = material.ks * r.dot(view).max(0.0).powf(material.shininess);
+            color += (diffuse + DVec3::splat(specular)) * light.color * pass;
+        }
+
+        if depth < self.settings.max_depth {
+            let mut reflect_weight = material.reflectivity;
+            if material.transparency > 0.0 {
+                let eta = if entering {
+                    1.0 / material.ior
+                } else {
+                    material.ior
+                };
+                match refract(ray.dir, n, eta) {
+                    Some(dir) => {
+                        rays.refraction += 1;
+                        let origin = offset_ray_origin(p, -facing, self.floor_scale);
+                        color += material.transparency
+                            * self.trace(&Ray::new(origin, dir), depth + 1, counter, rays);
+                    }
+                    // Total internal reflection: the transmitted share is reflected.
+                    None => reflect_weight += material.transparency,
+                }
+            }
+            if reflect_weight > 0.0 {
+                rays.reflection += 1;
+                let mut dir = reflect(ray.dir, n);
+                // An interpolated normal can send the mirror ray below the
+                // surface; fall back to the geometric mirror direction.
+                if dir.dot(facing) <= 0.0 {
+                    dir = reflect(ray.dir, facing);
+                }
+                let origin = offset_ray_origin(p, facing, self.floor_scale);
+                color += reflect_weight
+                    * self.trace(&Ray::new(origin, dir.normalize()), depth + 1, counter, rays);
+            }
+        }
+        color
+    }
+
+    /// One sample of a non-shaded view for the eye ray `ray`.
+    fn inspect<C: Counter>(&self, ray: &Ray, counter: &mut C, rays: &mut RayCounts) -> DVec3 {
+        let prepared = PreparedRay::new(*ray);
+        let Some(hit) = self.closest(&prepared, counter) else {
+            return DVec3::ZERO;
+        };
+        rays.primary_hits += 1;
+        match self.settings.view {
+            ViewMode::Normals => {
+                let s = self.scene.shapes[hit.shape as usize].surface(
+                    ray,
+                    &hit.hit,
+                    &self.scene.vertex_normals,
+                );
+                let n = s.geometric_normal;
+                let facing = if n.dot(ray.dir) > 0.0 { -n } else { n };
+                (facing + DVec3::ONE) * 0.5
+            }
+            _ => DVec3::new(hit.hit.t, 1.0, 0.0),
+        }
+    }
+
+    /// Value of pixel `(i, j)`: the mean over its samples.
+    pub fn pixel<C: Counter>(
+        &self,
+        i: u32,
+        j: u32,
+        counter: &mut C,
+        counts: &mut TileCounts,
+    ) -> DVec3 {
+        let mut sum = DVec3::ZERO;
+        let mut depth_hits = 0.0;
+        for &(dx, dy) in &self.offsets {
+            let ray = self.camera.ray(i, j, dx, dy);
+            counts.rays.primary += 1;
+            let mut value = match self.settings.view {
+                ViewMode::Shaded => self.trace(&ray, 1, counter, &mut counts.rays),
+                _ => self.inspect(&ray, counter, &mut counts.rays),
+            };
+            if !value.is_finite() {
+                counts.nonfinite_samples += 1;
+                value = DVec3::ZERO;
+            }
+            if self.settings.view == ViewMode::Depth {
+                depth_hits += value.y;
+                sum.x += value.x;
+            } else {
+                sum += value;
+            }
+        }
+        let n = self.offsets.len() as f64;
+        match self.settings.view {
+            ViewMode::Depth if depth_hits > 0.0 => {
+                DVec3::new(sum.x / depth_hits, depth_hits / n, 0.0)
+            }
+            ViewMode::Depth => DVec3::ZERO,
+            _ => sum / n,
+        }
+    }
+
+    /// Renders one tile into a row-major buffer of `tile.width * tile.height`.
+    pub fn render_tile(&self, tile: Tile, count_work: bool) -> (Vec<DVec3>, TileCounts) {
+        let mut out = Vec::with_capacity((tile.width * tile.height) as usize);
+        let mut counts = TileCounts::default();
+        if count_work {
+            let mut work = WorkCounts::default();
+            for j in tile.y..tile.y + tile.height {
+                for i in tile.x..tile.x + tile.width {
+                    out.push(self.pixel(i, j, &mut work, &mut counts));
+                }
+            }
+            counts.work = work;
+        } else {
+            for j in tile.y..tile.y + tile.height {
+                for i in tile.x..tile.x + tile.width {
+                    out.push(self.pixel(i, j, &mut NoCounts, &mut counts));
+                }
+            }
+        }
+        (out, counts)
+    }
+
+    /// Renders the whole frame on the current rayon pool. `progress` is
+    /// called with (tiles done, tiles total) as tiles finish.
+    pub fn render(
+        &self,
+        count_work: bool,
+        progress: Option<&(dyn Fn(u64, u64) + Sync)>,
+    ) -> (Frame, TileCounts) {
+        let (w, h) = (self.settings.width, self.settings.height);
+        let all = tiles(w, h);
+        let total = all.len() as u64;
+        let done = AtomicU64::new(0);
+        let results: Vec<(Vec<DVec3>, TileCounts)> = all
+            .par_iter()
+            .map(|&t| {
+                let r = self.render_tile(t, count_work);
+                let n = done.fetch_add(1, Ordering::Relaxed) + 1;
+                if let Some(p) = progress {
+                    p(n, total);
+                }
+                r
+            })
+            .collect();
+        let mut pixels = vec![DVec3::ZERO; (w * h) as usize];
+        let mut counts = TileCounts::default();
+        for (tile, (values, c)) in all.iter().zip(results) {
+            counts += c;
+            for row in 0..tile.height {
+                let start = ((tile.y + row) * w + tile.x) as usize;
+                let src = (row * tile.width) as usize;
+                pixels[start..start + tile.width as usize]
+                    .copy_from_slice(&values[src..src + tile.width as usize]);
+            }
+        }
+        (
+            Frame {
+                width: w,
+                height: h,
+                view: self.settings.view,
+                pixels,
+            },
+            counts,
+        )
+    }
+}
+
+/// sRGB transfer function (IEC 61966-2-1) of a linear value in `[0, 1]`.
+pub fn linear_to_srgb(x: f64) -> f64 {
+    let x = x.clamp(0.0, 1.0);
+    if x <= 0.003_130_8 {
+        12.92 * x
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+fn to_byte(x: f64) -> u8 {
+    (x.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+impl Frame {
+    /// 8-bit RGB, row-major from the top: sRGB-encoded for the shaded view,
+    /// raw for normals, normalised to the visible range for depth.
+    pub fn to_rgb8(&self) -> Vec<u8> {
+        let mut out = Vec::with_capacity(self.pixels.len() * 3);
+        match self.view {
+            ViewMode::Shaded => {
+                for p in &self.pixels {
+                    out.extend([p.x, p.y, p.z].map(|c| to_byte(linear_to_srgb(c))));
+                }
+            }
+            ViewMode::Normals => {
+                for p in &self.pixels {
+                    out.extend([p.x, p.y, p.z].map(to_byte));
+                }
+            }
+            ViewMode::Depth => {
+                let hits = self.pixels.iter().filter(|p| p.y > 0.0);
+                let (near, far) = hits.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                    (lo.min(p.x), hi.max(p.x))
+                });
+                let range = far - near;
+                for p in &self.pixels {
+                    let v = if p.y <= 0.0 {
+                        0.0
+                    } else if range > 0.0 {
+                        // Pixels partly covered fade towards the black background.
+                        (1.0 - (p.x - near) / range) * p.y
+                    } else {
+                        p.y
+                    };
+                    out.extend([to_byte(v); 3]);
+                }
+            }
+        }
+        out
+    }
+
+    /// Writes a PNG, through a temporary file renamed into place so a
+    /// failed write never leaves a truncated image behind.
+    pub fn save_png(&self, path: &std::path::Path) -> Result<(), image::ImageError> {
+        let img = image::RgbImage::from_raw(self.width, self.height, self.to_rgb8())
+            .expect("the buffer has width * height * 3 bytes");
+        let file_name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let tmp = path.with_file_name(format!(".{file_name}.{}.tmp", std::process::id()));
+        img.save_with_format(&tmp, image::ImageFormat::Png)?;
+        std::fs::rename(&tmp, path).map_err(|e| {
+            let _ = std::fs::remove_file(&tmp);
+            image::ImageError::IoError(e)
+        })
+    }
+}

@@ -1,0 +1,186 @@
+//! A scene as the renderer sees it, and the two file formats that describe it:
+//! glint's own TOML ([`toml_format`]) and Eric Haines's NFF ([`nff`]).
+
+mod mesh;
+pub mod nff;
+pub mod toml_format;
+
+use std::path::{Path, PathBuf};
+
+use crate::accel::OctreeParams;
+use crate::camera::CameraSpec;
+use crate::material::{Light, Material};
+use crate::math::{Aabb, Color, DVec3};
+use crate::shapes::Shape;
+
+/// Image and recursion settings stored with a scene; command-line flags and
+/// the viewer override them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImageSettings {
+    pub width: u32,
+    pub height: u32,
+    /// Rays per pixel: 1 (the pixel centre) or 16 (a regular 4x4 grid).
+    pub samples: u32,
+    /// Longest ray path, the eye ray counting as depth 1.
+    pub max_depth: u32,
+    pub background: Color,
+    pub ambient: Color,
+}
+
+impl Default for ImageSettings {
+    fn default() -> Self {
+        Self {
+            width: 640,
+            height: 480,
+            samples: 16,
+            max_depth: 5,
+            background: DVec3::ZERO,
+            ambient: DVec3::splat(0.1),
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    /// Where the scene came from, for messages and statistics.
+    pub name: String,
+    pub camera: CameraSpec,
+    pub image: ImageSettings,
+    pub octree_enabled: bool,
+    pub octree_params: OctreeParams,
+    pub materials: Vec<Material>,
+    pub lights: Vec<Light>,
+    /// Shapes and their material indices, side by side (structure of arrays:
+    /// the intersection loop touches only `shapes`).
+    pub shapes: Vec<Shape>,
+    pub shape_materials: Vec<u32>,
+    /// Per-triangle vertex normals of smooth-shaded triangles.
+    pub vertex_normals: Vec<[DVec3; 3]>,
+    /// Degenerate triangles dropped while loading (they could never be hit).
+    pub dropped_triangles: usize,
+}
+
+impl Scene {
+    pub fn push(&mut self, shape: Shape, material: u32) {
+        self.shapes.push(shape);
+        self.shape_materials.push(material);
+    }
+
+    /// Bounds of every bounded shape, the lights and the eye: the magnitude
+    /// of the numbers the renderer works with.
+    pub fn extent_bounds(&self) -> Aabb {
+        let mut b = Aabb::EMPTY.grow(self.camera.eye).grow(self.camera.lookat);
+        for light in &self.lights {
+            b = b.grow(light.position);
+        }
+        for shape in &self.shapes {
+            match shape {
+                Shape::Plane(p) => b = b.grow(p.point),
+                _ => {
+                    if let Some(sb) = shape.bounds() {
+                        b = b.union(sb);
+                    }
+                }
+            }
+        }
+        b
+    }
+
+    /// Counts of shapes by kind, e.g. `[("sphere", 3), ("triangle", 12)]`.
+    pub fn shape_counts(&self) -> Vec<(&'static str, usize)> {
+        let mut counts: Vec<(&'static str, usize)> = Vec::new();
+        for s in &self.shapes {
+            match counts.iter_mut().find(|(k, _)| *k == s.kind_name()) {
+                Some((_, n)) => *n += 1,
+                None => counts.push((s.kind_name(), 1)),
+            }
+        }
+        counts
+    }
+}
+
+/// Where in a scene file something went wrong.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Location {
+    pub path: PathBuf,
+    pub line: usize,
+    pub column: usize,
+    /// The key (TOML) or entity (NFF) at fault.
+    pub key: String,
+}
+
+impl std::fmt::Display for Location {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{}:{}:{}: `{}`",
+            self.path.display(),
+            self.line,
+            self.column,
+            self.key
+        )
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    #[error("cannot read scene file {path}: {source}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{path} is not UTF-8 text (first bad byte at offset {offset})")]
+    NotUtf8 { path: PathBuf, offset: usize },
+    #[error("{location}: {message}")]
+    Invalid { location: Location, message: String },
+    #[error("{location}: mesh {mesh}: {message}")]
+    Mesh {
+        location: Location,
+        mesh: PathBuf,
+        message: String,
+    },
+    #[error("{path}: unknown scene format (expected a .toml or .nff file)")]
+    UnknownFormat { path: PathBuf },
+}
+
+/// Loads a `.toml` or `.nff` scene file.
+pub fn load(path: &Path) -> Result<Scene, SceneError> {
+    let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
+        path: path.to_owned(),
+        source,
+    })?;
+    let text = String::from_utf8(bytes).map_err(|e| SceneError::NotUtf8 {
+        path: path.to_owned(),
+        offset: e.utf8_error().valid_up_to(),
+    })?;
+    load_str(&text, path, &mesh::FileSystem)
+}
+
+/// Parses scene text; `path` names it in errors, chooses the format by its
+/// extension and anchors relative mesh paths.
+pub fn load_str(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, SceneError> {
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
+        Some("toml") => toml_format::parse(text, path, files),
+        Some("nff") => nff::parse(text, path),
+        _ => Err(SceneError::UnknownFormat {
+            path: path.to_owned(),
+        }),
+    }
+}
+
+pub use mesh::{FileSystem, MeshSource};
+
+/// 1-based line and column of a byte offset.
+pub(crate) fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let offset = offset.min(text.len());
+    let before = &text[..text.floor_char_boundary(offset)];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, column)
+}

@@ -1,0 +1,535 @@
+//! Eric Haines's Neutral File Format (NFF), the language of the Standard
+//! Procedural Databases (SPD). Entities may span lines, so the file is read
+//! as a stream of whitespace-separated tokens, each remembering its place.
+
+use std::path::Path;
+
+use super::{ImageSettings, Location, Scene, SceneError};
+use crate::accel::OctreeParams;
+use crate::camera::CameraSpec;
+use crate::material::{Light, Material};
+use crate::math::DVec3;
+use crate::shapes::{Cone, Shape, Sphere};
+
+/// More vertices than any sane polygon has; guards against `p 999999999`.
+const MAX_POLYGON_VERTICES: usize = 1 << 16;
+
+struct Token<'a> {
+    text: &'a str,
+    line: usize,
+    column: usize,
+}
+
+struct Tokens<'a> {
+    path: &'a Path,
+    tokens: Vec<Token<'a>>,
+    next: usize,
+    /// Place of the entity being read, for "ended too early" errors.
+    entity: (usize, usize, &'a str),
+}
+
+impl<'a> Tokens<'a> {
+    fn new(text: &'a str, path: &'a Path) -> Self {
+        let mut tokens = Vec::new();
+        for (l, line) in text.lines().enumerate() {
+            let line = line.split('#').next().unwrap_or("");
+            let mut rest = line;
+            while let Some(start) = rest.find(|c: char| !c.is_whitespace()) {
+                let tail = &rest[start..];
+                let len = tail.find(char::is_whitespace).unwrap_or(tail.len());
+                let offset = line.len() - rest.len() + start;
+                tokens.push(Token {
+                    text: &tail[..len],
+                    line: l + 1,
+                    column: line[..offset].chars().count() + 1,
+                });
+                rest = &tail[len..];
+            }
+        }
+        Self {
+            path,
+            tokens,
+            next: 0,
+            entity: (1, 1, ""),
+        }
+    }
+
+    fn error_at(
+        &self,
+        line: usize,
+        column: usize,
+        key: &str,
+        message: impl Into<String>,
+    ) -> SceneError {
+        SceneError::Invalid {
+            location: Location {
+                path: self.path.to_owned(),
+                line,
+                column,
+                key: key.to_owned(),
+            },
+            message: message.into(),
+        }
+    }
+
+    fn next_token(&mut self, what: &str) -> Result<&Token<'a>, SceneError> {
+        match self.tokens.get(self.next) {
+            Some(_) => {
+                self.next += 1;
+                Ok(&self.tokens[self.next - 1])
+            }
+            None => {
+                let (line, column, key) = self.entity;
+                Err(self.error_at(line, column, key, format!("file ends while reading {what}")))
+            }
+        }
+    }
+
+    fn number(&mut self, what: &str) -> Result<f64, SceneError> {
+        let key = self.entity.2;
+        let t = self.next_token(what)?;
+        let (text, line, column) = (t.text, t.line, t.column);
+        match text.parse::<f64>() {
+            Ok(x) if x.is_finite() => Ok(x),
+            Ok(x) => {
+                Err(self.error_at(line, column, key, format!("{what} must be finite, got {x}")))
+            }
+            Err(_) => Err(self.error_at(
+                line,
+                column,
+                key,
+                format!("expected a number for {what}, got `{text}`"),
+            )),
+        }
+    }
+
+    fn vec3(&mut self, what: &str) -> Result<DVec3, SceneError> {
+        Ok(DVec3::new(
+            self.number(what)?,
+            self.number(what)?,
+            self.number(what)?,
+        ))
+    }
+
+    fn count(&mut self, what: &str, max: usize) -> Result<usize, SceneError> {
+        let key = self.entity.2;
+        let t = self.next_token(what)?;
+        let (text, line, column) = (t.text, t.line, t.column);
+        match text.parse::<usize>() {
+            Ok(n) if n <= max => Ok(n),
+            _ => Err(self.error_at(
+                line,
+                column,
+                key,
+                format!("{what} must be a whole number up to {max}, got `{text}`"),
+            )),
+        }
+    }
+
+    /// Reads the label of a `v` entity's line, e.g. `from`.
+    fn label(&mut self, expected: &str) -> Result<(), SceneError> {
+        let key = self.entity.2;
+        let t = self.next_token(expected)?;
+        if t.text == expected {
+            Ok(())
+        } else {
+            let (text, line, column) = (t.text, t.line, t.column);
+            Err(self.error_at(
+                line,
+                column,
+                key,
+                format!("expected `{expected}`, got `{text}`"),
+            ))
+        }
+    }
+}
+
+/// Vertical field of view (edge to edge of the image) from NFF's angle,
+/// which is measured between the centres of the first and last pixel rows.
+pub fn fov_from_nff_angle(angle_degrees: f64, rows: u32) -> f64 {
+    if rows <= 1 {
+        return angle_degrees;
+    }
+    let half = (angle_degrees.to_radians() * 0.5).tan() * rows as f64 / (rows - 1) as f64;
+    2.0 * half.atan().to_degrees()
+}
+
+/// NFF colours are display values (the SPD images were shown without any
+/// transfer function), so glint decodes them as sRGB into linear RGB.
+fn srgb_to_linear(c: DVec3) -> DVec3 {
+    let decode = |x: f64| {
+        let x = x.clamp(0.0, 1.0);
+        if x <= 0.040_45 {
+            x / 12.92
+        } else {
+            ((x + 0.055) / 1.055).powf(2.4)
+        }
+    };
+    DVec3::new(decode(c.x), decode(c.y), decode(c.z))
+}
+
+pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
+    let mut tokens = Tokens::new(text, path);
+    let mut camera: Option<CameraSpec> = None;
+    let mut image = ImageSettings {
+        samples: 1,
+        max_depth: 5,
+        background: DVec3::ZERO,
+        ..ImageSettings::default()
+    };
+    // Lights given without a colour; their intensity depends on the final count.
+    let mut uncoloured_lights = Vec::new();
+    let mut scene = Scene {
+        name: path.display().to_string(),
+        camera: CameraSpec {
+            eye: DVec3::ZERO,
+            lookat: DVec3::NEG_Z,
+            up: DVec3::Y,
+            fov: 45.0,
+        },
+        image: image.clone(),
+        octree_enabled: true,
+        octree_params: OctreeParams::default(),
+        materials: Vec::new(),
+        lights: Vec::new(),
+        shapes: Vec::new(),
+        shape_materials: Vec::new(),
+        vertex_normals: Vec::new(),
+        dropped_triangles: 0,
+    };
+    let mut material: Option<u32> = None;
+
+    while tokens.next < tokens.tokens.len() {
+        let t = &tokens.tokens[tokens.next];
+        tokens.next += 1;
+        let (keyword, line, column) = (t.text, t.line, t.column);
+        tokens.entity = (line, column, keyword);
+        let needs_material = |m: Option<u32>, tokens: &Tokens| {
+            m.ok_or_else(|| {
+                tokens.error_at(
+                    line,
+                    column,
+                    keyword,
+                    "an object comes before any `f` material",
+                )
+            })
+        };
+        match keyword {
+            "v" => {
+                tokens.label("from")?;
+                let eye = tokens.vec3("from")?;
+                tokens.label("at")?;
+                let lookat = tokens.vec3("at")?;
+                tokens.label("up")?;
+                let up = tokens.vec3("up")?;
+                tokens.label("angle")?;
+                let angle = tokens.number("angle")?;
+                tokens.label("hither")?;
+                let _hither = tokens.number("hither")?;
+                tokens.label("resolution")?;
+                let limit = super::toml_format::MAX_IMAGE_SIDE as usize;
+                let w = tokens.count("resolution", limit)?;
+                let h = tokens.count("resolution", limit)?;
+                if w == 0 || h == 0 {
+                    return Err(tokens.error_at(
+                        line,
+                        column,
+                        "v",
+                        "resolution must be at least 1x1",
+                    ));
+                }
+                if !(angle > 0.0 && angle < 180.0) {
+                    return Err(tokens.error_at(
+                        line,
+                        column,
+                        "v",
+                        format!("angle must lie between 0 and 180, got {angle}"),
+                    ));
+                }
+                image.width = w as u32;
+                image.height = h as u32;
+                camera = Some(CameraSpec {
+                    eye,
+                    lookat,
+                    up,
+                    fov: fov_from_nff_angle(angle, h as u32),
+                });
+            }
+            "b" => image.background = srgb_to_linear(tokens.vec3("background colour")?),
+            "l" => {
+                let position = tokens.vec3("light position")?;
+                // The colour is optional: it is present if the next token is a number.
+                let has_colour = tokens
+                    .tokens
+                    .get(tokens.next)
+                    .is_some_and(|t| t.text.parse::<f64>().is_ok());
+                if has_colour {
+                    let color = tokens.vec3("light colour")?.max(DVec3::ZERO);
+                    scene.lights.push(Light { position, color });
+                } else {
+                    uncoloured_lights.push(scene.lights.len());
+                    scene.lights.push(Light {
+                        position,
+                        color: DVec3::ONE,
+                    });
+                }
+            }
+            "f" => {
+                let color = srgb_to_linear(tokens.vec3("colour")?);
+                let kd = tokens.number("Kd")?.max(0.0);
+                let ks = tokens.number("Ks")?.max(0.0);
+                let shininess = tokens.number("Shine")?.max(0.0);
+                let transparency = tokens.number("T")?.max(0.0);
+                let ior = tokens.number("index of refraction")?;
+                let ior = if ior > 0.0 { ior } else { 1.0 };
+                let m = Material {
+                    name: format!("f{}", scene.materials.len() + 1),
+                    color,
+                    ka: kd,
+                    kd,
+                    ks,
+                    shininess,
+                    // NFF's Ks weights both the highlight and the mirror ray.
+                    reflectivity: ks,
+                    transparency,
+                    ior,
+                };
+                let same = |o: &Material| {
+                    (o.color, o.kd, o.ks, o.shininess, o.transparency, o.ior)
+                        == (m.color, m.kd, m.ks, m.shininess, m.transparency, m.ior)
+                };
+                material = Some(match scene.materials.iter().position(same) {
+                    Some(i) => i as u32,
+                    None => {
+                        scene.materials.push(m);
+                        (scene.materials.len() - 1) as u32
+                    }
+                });
+            }
+            "s" => {
+                let center = tokens.vec3("sphere centre")?;
+                let radius = tokens.number("sphere radius")?.abs();
+                let m = needs_material(material, &tokens)?;
+                if radius == 0.0 {
+                    return Err(tokens.error_at(
+                        line,
+                        column,
+                        "s",
+                        "sphere radius must not be zero",
+                    ));
+                }
+                scene.push(Shape::Sphere(Sphere::new(center, radius)), m);
+            }
+            "c" => {
+                let base = tokens.vec3("cone base")?;
+                let base_radius = tokens.number("cone base radius")?;
+                let apex = tokens.vec3("cone apex")?;
+                let apex_radius = tokens.number("cone apex radius")?;
+                let m = needs_material(material, &tokens)?;
+                let cone = Cone::new(base, base_radius, apex, apex_radius).ok_or_else(|| {
+                    tokens.error_at(line, column, "c", "cone base and apex coincide")
+                })?;
+                scene.push(Shape::Cone(cone), m);
+            }
+            "p" | "pp" => {
+                let with_normals = keyword == "pp";
+                let n = tokens.count("vertex count", MAX_POLYGON_VERTICES)?;
+                if n < 3 {
+                    return Err(tokens.error_at(
+                        line,
+                        column,
+                        keyword,
+                        format!("a polygon needs at least 3 vertices, got {n}"),
+                    ));
+                }
+                let mut vertices = Vec::with_capacity(n);
+                let mut normals = Vec::with_capacity(if with_normals { n } else { 0 });
+                for _ in 0..n {
+                    vertices.push(tokens.vec3("vertex")?);
+                    if with_normals {
+                        normals.push(tokens.vec3("vertex normal")?);
+                    }
+                }
+                let m = needs_material(material, &tokens)?;
+                // Convex polygons: a fan from the first vertex.
+                let triangles: Vec<[DVec3; 3]> = (1..n - 1)
+                    .map(|i| [vertices[0], vertices[i], vertices[i + 1]])
+                    .collect();
+                let tri_normals = with_normals.then(|| {
+                    (1..n - 1)
+                        .map(|i| {
+                            [normals[0], normals[i], normals[i + 1]].map(|v| v.normalize_or_zero())
+                        })
+                        .collect()
+                });
+                super::toml_format::push_mesh(&mut scene, triangles, tri_normals, m);
+            }
+            other => {
+                return Err(tokens.error_at(
+                    line,
+                    column,
+                    other,
+                    format!("unknown NFF entity `{other}`"),
+                ));
+            }
+        }
+    }
+
+    scene.camera =
+        camera.ok_or_else(|| tokens.error_at(1, 1, "v", "the file has no `v` viewpoint"))?;
+    // NFF leaves light intensity open; SPD's convention is sqrt(n)/(2n) for
+    // n lights, and the ambient gets the same.
+    let n = scene.lights.len().max(1) as f64;
+    let intensity = n.sqrt() / (2.0 * n);
+    for i in uncoloured_lights {
+        scene.lights[i].color = DVec3::splat(intensity);
+    }
+    image.ambient = DVec3::splat(intensity);
+    scene.image = image;
+    Ok(scene)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SCENE: &str = "\
+# a comment
+v
+from 0 0 5
+at 0 0 0
+up 0 1 0
+angle 40
+hither 0.01
+resolution 64 48
+b 0.1 0.2 0.3
+l 5 5 5
+l -5 5 5 1 0 0
+f 1 0.5 0.2 0.7 0.3 20 0 1
+s 0 0 0 1
+c 0 0 0 1 0 1 0 0.5
+p 4
+-1 -1 -2
+1 -1 -2
+1 1 -2
+-1 1 -2
+pp 3
+0 0 -3 0 0 1
+1 0 -3 0 0 1
+0 1 -3 0 0 1
+";
+
+    fn parse_str(text: &str) -> Result<Scene, SceneError> {
+        parse(text, Path::new("t.nff"))
+    }
+
+    #[test]
+    fn entities_become_shapes_lights_and_materials() {
+        let s = parse_str(SCENE).unwrap();
+        assert_eq!(
+            s.shape_counts(),
+            vec![("sphere", 1), ("cone", 1), ("triangle", 3)]
+        );
+        assert_eq!((s.image.width, s.image.height), (64, 48));
+        assert_eq!(s.lights.len(), 2);
+        let expected = 2f64.sqrt() / 4.0;
+        assert!((s.lights[0].color - DVec3::splat(expected)).length() < 1e-15);
+        assert_eq!(s.lights[1].color, DVec3::X);
+        assert!(
+            (s.image.background.z - 0.073).abs() < 1e-3,
+            "sRGB 0.3 is linear 0.073"
+        );
+        assert_eq!(s.materials.len(), 1);
+        assert_eq!(s.materials[0].reflectivity, 0.3);
+        assert_eq!(s.vertex_normals.len(), 1);
+    }
+
+    #[test]
+    fn angle_is_converted_to_edge_to_edge_fov() {
+        // The centres of rows 0 and h-1 span (h-1) pixels, the image h.
+        let fov = fov_from_nff_angle(45.0, 512);
+        let expected = 2.0
+            * ((22.5f64).to_radians().tan() * 512.0 / 511.0)
+                .atan()
+                .to_degrees();
+        assert!((fov - expected).abs() < 1e-12 && fov > 45.0);
+        assert_eq!(fov_from_nff_angle(45.0, 1), 45.0);
+    }
+
+    #[test]
+    fn errors_name_line_column_and_entity() {
+        let cases = [
+            (
+                "s 0 0 0 1",
+                "s 0 0 zero 1",
+                "t.nff:13:7: `s`: expected a number for sphere centre, got `zero`",
+            ),
+            (
+                "s 0 0 0 1",
+                "s 0 0 0 nan",
+                "t.nff:13:9: `s`: sphere radius must be finite",
+            ),
+            (
+                "p 4",
+                "p 99999999999",
+                "t.nff:15:3: `p`: vertex count must be a whole number",
+            ),
+            (
+                "p 4",
+                "p 2",
+                "t.nff:15:1: `p`: a polygon needs at least 3 vertices",
+            ),
+            (
+                "s 0 0 0 1",
+                "sphere 0 0 0 1",
+                "t.nff:13:1: `sphere`: unknown NFF entity",
+            ),
+            (
+                "angle 40",
+                "angle 400",
+                "t.nff:2:1: `v`: angle must lie between 0 and 180",
+            ),
+            (
+                "from 0 0 5",
+                "fro 0 0 5",
+                "t.nff:3:1: `v`: expected `from`, got `fro`",
+            ),
+            (
+                "c 0 0 0 1 0 1 0 0.5",
+                "c 0 0 0 1 0 0 0 0.5",
+                "t.nff:14:1: `c`: cone base and apex coincide",
+            ),
+        ];
+        for (from, to, expected) in cases {
+            let message = parse_str(&SCENE.replacen(from, to, 1))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                message.contains(expected),
+                "for {to:?}:\n  got      {message}\n  expected {expected}"
+            );
+        }
+    }
+
+    #[test]
+    fn truncated_files_and_missing_pieces_are_errors() {
+        let cut = &SCENE[..SCENE.find("-1 1 -2").unwrap()];
+        let message = parse_str(cut).unwrap_err().to_string();
+        assert!(
+            message.contains("t.nff:15:1: `p`: file ends while reading vertex"),
+            "{message}"
+        );
+        assert!(
+            parse_str("s 0 0 0 1\n")
+                .unwrap_err()
+                .to_string()
+                .contains("before any `f`")
+        );
+        assert!(
+            parse_str("b 0 0 0\n")
+                .unwrap_err()
+                .to_string()
+                .contains("no `v` viewpoint")
+        );
+    }
+}

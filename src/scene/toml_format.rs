@@ -1,0 +1,746 @@
+//! glint's own scene format; every key is documented in `scenes/README.md`.
+
+use std::collections::BTreeMap;
+use std::ops::Range;
+use std::path::Path;
+
+use serde::Deserialize;
+use toml::Spanned;
+
+use super::mesh::{MeshSource, Placement, parse_obj};
+use super::{ImageSettings, Location, Scene, SceneError};
+use crate::accel::OctreeParams;
+use crate::camera::CameraSpec;
+use crate::material::{Light, Material};
+use crate::math::{Aabb, DVec3};
+use crate::shapes::{Plane, Quadric, Shape, Sphere, Triangle};
+
+type Vec3 = Spanned<[f64; 3]>;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SceneFile {
+    camera: CameraFile,
+    #[serde(default)]
+    image: ImageFile,
+    #[serde(default)]
+    octree: OctreeFile,
+    #[serde(default)]
+    materials: BTreeMap<String, MaterialFile>,
+    #[serde(default)]
+    lights: Vec<LightFile>,
+    #[serde(default)]
+    objects: Vec<ObjectFile>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CameraFile {
+    eye: Vec3,
+    lookat: Vec3,
+    up: Vec3,
+    fov: Spanned<f64>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct ImageFile {
+    width: Option<Spanned<i64>>,
+    height: Option<Spanned<i64>>,
+    samples: Option<Spanned<i64>>,
+    max_depth: Option<Spanned<i64>>,
+    background: Option<Vec3>,
+    ambient: Option<Vec3>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct OctreeFile {
+    enabled: Option<bool>,
+    max_depth: Option<Spanned<i64>>,
+    leaf_size: Option<Spanned<i64>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MaterialFile {
+    color: Option<Vec3>,
+    kd: Option<Spanned<f64>>,
+    ks: Option<Spanned<f64>>,
+    shininess: Option<Spanned<f64>>,
+    reflectivity: Option<Spanned<f64>>,
+    transparency: Option<Spanned<f64>>,
+    ior: Option<Spanned<f64>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LightFile {
+    position: Vec3,
+    color: Option<Vec3>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ClipFile {
+    min: Vec3,
+    max: Vec3,
+}
+
+/// Every key any object kind may have; which ones a kind takes is checked
+/// after parsing so that errors keep their place in the file.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ObjectFile {
+    kind: Spanned<String>,
+    material: Spanned<String>,
+    center: Option<Vec3>,
+    radius: Option<Spanned<f64>>,
+    point: Option<Vec3>,
+    normal: Option<Vec3>,
+    vertices: Option<Spanned<[[f64; 3]; 3]>>,
+    coefficients: Option<Spanned<[f64; 10]>>,
+    clip: Option<Spanned<ClipFile>>,
+    path: Option<Spanned<String>>,
+    scale: Option<Spanned<f64>>,
+    rotate: Option<Vec3>,
+    translate: Option<Vec3>,
+    smooth: Option<Spanned<bool>>,
+}
+
+struct Context<'a> {
+    text: &'a str,
+    path: &'a Path,
+}
+
+impl Context<'_> {
+    fn location(&self, span: Range<usize>, key: &str) -> Location {
+        let (line, column) = super::line_column(self.text, span.start);
+        Location {
+            path: self.path.to_owned(),
+            line,
+            column,
+            key: key.to_owned(),
+        }
+    }
+
+    fn error(&self, span: Range<usize>, key: &str, message: impl Into<String>) -> SceneError {
+        SceneError::Invalid {
+            location: self.location(span, key),
+            message: message.into(),
+        }
+    }
+
+    fn finite(&self, v: &Spanned<f64>, key: &str) -> Result<f64, SceneError> {
+        let x = *v.get_ref();
+        if x.is_finite() {
+            Ok(x)
+        } else {
+            Err(self.error(v.span(), key, format!("must be a finite number, got {x}")))
+        }
+    }
+
+    fn vec3(&self, v: &Vec3, key: &str) -> Result<DVec3, SceneError> {
+        let p = DVec3::from(*v.get_ref());
+        if p.is_finite() {
+            Ok(p)
+        } else {
+            Err(self.error(
+                v.span(),
+                key,
+                format!("must be three finite numbers, got {p}"),
+            ))
+        }
+    }
+
+    fn color(&self, v: &Vec3, key: &str) -> Result<DVec3, SceneError> {
+        let c = self.vec3(v, key)?;
+        if c.min_element() < 0.0 {
+            return Err(self.error(v.span(), key, "colour components must not be negative"));
+        }
+        Ok(c)
+    }
+
+    fn non_negative(&self, v: &Spanned<f64>, key: &str) -> Result<f64, SceneError> {
+        let x = self.finite(v, key)?;
+        if x < 0.0 {
+            return Err(self.error(v.span(), key, format!("must not be negative, got {x}")));
+        }
+        Ok(x)
+    }
+
+    fn integer(&self, v: &Spanned<i64>, key: &str, range: Range<i64>) -> Result<u32, SceneError> {
+        let x = *v.get_ref();
+        if range.contains(&x) {
+            Ok(x as u32)
+        } else {
+            Err(self.error(
+                v.span(),
+                key,
+                format!(
+                    "must be an integer from {} to {}, got {x}",
+                    range.start,
+                    range.end - 1
+                ),
+            ))
+        }
+    }
+}
+
+/// Largest image side and recursion depth a file may ask for: beyond these
+/// a typo would allocate gigabytes or recurse without end.
+pub const MAX_IMAGE_SIDE: i64 = 1 << 15;
+pub const MAX_DEPTH_LIMIT: i64 = 64;
+
+pub fn parse(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, SceneError> {
+    let cx = Context { text, path };
+    let file: SceneFile = toml::from_str(text).map_err(|e| {
+        let span = e.span().unwrap_or(0..0);
+        let key = key_at(text, span.start);
+        cx.error(span, &key, e.message().trim().to_owned())
+    })?;
+
+    let camera = CameraSpec {
+        eye: cx.vec3(&file.camera.eye, "camera.eye")?,
+        lookat: cx.vec3(&file.camera.lookat, "camera.lookat")?,
+        up: cx.vec3(&file.camera.up, "camera.up")?,
+        fov: cx.finite(&file.camera.fov, "camera.fov")?,
+    };
+    if !(camera.fov > 0.0 && camera.fov < 180.0) {
+        return Err(cx.error(
+            file.camera.fov.span(),
+            "camera.fov",
+            "must lie strictly between 0 and 180 degrees",
+        ));
+    }
+
+    let mut image = ImageSettings::default();
+    let im = &file.image;
+    if let Some(v) = &im.width {
+        image.width = cx.integer(v, "image.width", 1..MAX_IMAGE_SIDE + 1)?;
+    }
+    if let Some(v) = &im.height {
+        image.height = cx.integer(v, "image.height", 1..MAX_IMAGE_SIDE + 1)?;
+    }
+    if let Some(v) = &im.samples {
+        image.samples = cx.integer(v, "image.samples", 1..17)?;
+        if image.samples != 1 && image.samples != 16 {
+            return Err(cx.error(v.span(), "image.samples", "must be 1 or 16"));
+        }
+    }
+    if let Some(v) = &im.max_depth {
+        image.max_depth = cx.integer(v, "image.max_depth", 1..MAX_DEPTH_LIMIT + 1)?;
+    }
+    if let Some(v) = &im.background {
+        image.background = cx.color(v, "image.background")?;
+    }
+    if let Some(v) = &im.ambient {
+        image.ambient = cx.color(v, "image.ambient")?;
+    }
+
+    let mut octree_params = OctreeParams::default();
+    if let Some(v) = &file.octree.max_depth {
+        octree_params.max_depth = cx.integer(v, "octree.max_depth", 0..22)?;
+    }
+    if let Some(v) = &file.octree.leaf_size {
+        octree_params.leaf_size = cx.integer(v, "octree.leaf_size", 1..1_000_001)?;
+    }
+
+    let mut materials = Vec::new();
+    for (name, m) in &file.materials {
+        let key = |k: &str| format!("materials.{name}.{k}");
+        let mut mat = Material {
+            name: name.clone(),
+            ..Material::default()
+        };
+        if let Some(v) = &m.color {
+            mat.color = cx.color(v, &key("color"))?;
+        }
+        for (slot, value, k) in [
+            (&mut mat.kd, &m.kd, "kd"),
+            (&mut mat.ks, &m.ks, "ks"),
+            (&mut mat.shininess, &m.shininess, "shininess"),
+            (&mut mat.reflectivity, &m.reflectivity, "reflectivity"),
+            (&mut mat.transparency, &m.transparency, "transparency"),
+        ] {
+            if let Some(v) = value {
+                *slot = cx.non_negative(v, &key(k))?;
+            }
+        }
+        if let Some(v) = &m.ior {
+            mat.ior = cx.finite(v, &key("ior"))?;
+            if mat.ior <= 0.0 {
+                return Err(cx.error(v.span(), &key("ior"), "must be positive"));
+            }
+        }
+        materials.push(mat);
+    }
+
+    let mut lights = Vec::new();
+    for (i, l) in file.lights.iter().enumerate() {
+        lights.push(Light {
+            position: cx.vec3(&l.position, &format!("lights[{i}].position"))?,
+            color: match &l.color {
+                Some(c) => cx.color(c, &format!("lights[{i}].color"))?,
+                None => DVec3::ONE,
+            },
+        });
+    }
+
+    let mut scene = Scene {
+        name: path.display().to_string(),
+        camera,
+        image,
+        octree_enabled: file.octree.enabled.unwrap_or(true),
+        octree_params,
+        materials,
+        lights,
+        shapes: Vec::new(),
+        shape_materials: Vec::new(),
+        vertex_normals: Vec::new(),
+        dropped_triangles: 0,
+    };
+    for (i, obj) in file.objects.iter().enumerate() {
+        add_object(&cx, &mut scene, i, obj, files)?;
+    }
+    Ok(scene)
+}
+
+fn add_object(
+    cx: &Context,
+    scene: &mut Scene,
+    index: usize,
+    obj: &ObjectFile,
+    files: &dyn MeshSource,
+) -> Result<(), SceneError> {
+    let key = |k: &str| format!("objects[{index}].{k}");
+    let kind = obj.kind.get_ref().as_str();
+    let material = scene
+        .materials
+        .iter()
+        .position(|m| m.name == *obj.material.get_ref())
+        .ok_or_else(|| {
+            let known: Vec<&str> = scene.materials.iter().map(|m| m.name.as_str()).collect();
+            cx.error(
+                obj.material.span(),
+                &key("material"),
+                format!(
+                    "no material named `{}` (defined: {})",
+                    obj.material.get_ref(),
+                    known.join(", ")
+                ),
+            )
+        })? as u32;
+
+    // Which keys each kind takes; anything else present is a mistake.
+    let allowed: &[&str] = match kind {
+        "sphere" => &["center", "radius"],
+        "plane" => &["point", "normal"],
+        "triangle" => &["vertices"],
+        "quadric" => &["coefficients", "clip"],
+        "mesh" => &["path", "scale", "rotate", "translate", "smooth"],
+        _ => {
+            return Err(cx.error(
+                obj.kind.span(),
+                &key("kind"),
+                format!(
+                    "unknown kind `{kind}` (expected sphere, plane, triangle, quadric or mesh)"
+                ),
+            ));
+        }
+    };
+    let present: [(&str, Option<Range<usize>>); 12] = [
+        ("center", obj.center.as_ref().map(Spanned::span)),
+        ("radius", obj.radius.as_ref().map(Spanned::span)),
+        ("point", obj.point.as_ref().map(Spanned::span)),
+        ("normal", obj.normal.as_ref().map(Spanned::span)),
+        ("vertices", obj.vertices.as_ref().map(Spanned::span)),
+        ("coefficients", obj.coefficients.as_ref().map(Spanned::span)),
+        ("clip", obj.clip.as_ref().map(Spanned::span)),
+        ("path", obj.path.as_ref().map(Spanned::span)),
+        ("scale", obj.scale.as_ref().map(Spanned::span)),
+        ("rotate", obj.rotate.as_ref().map(Spanned::span)),
+        ("translate", obj.translate.as_ref().map(Spanned::span)),
+        ("smooth", obj.smooth.as_ref().map(Spanned::span)),
+    ];
+    for (name, span) in &present {
+        if let Some(span) = span
+            && !allowed.contains(name)
+        {
+            return Err(cx.error(
+                span.clone(),
+                &key(name),
+                format!("`{name}` does not apply to a {kind}"),
+            ));
+        }
+    }
+    let required = |name: &str, has: bool| -> Result<(), SceneError> {
+        if has {
+            Ok(())
+        } else {
+            Err(cx.error(
+                obj.kind.span(),
+                &key(name),
+                format!("a {kind} needs `{name}`"),
+            ))
+        }
+    };
+
+    match kind {
+        "sphere" => {
+            required("center", obj.center.is_some())?;
+            required("radius", obj.radius.is_some())?;
+            let (c, r) = (obj.center.as_ref().unwrap(), obj.radius.as_ref().unwrap());
+            let center = cx.vec3(c, &key("center"))?;
+            let radius = cx.finite(r, &key("radius"))?;
+            if radius <= 0.0 {
+                return Err(cx.error(
+                    r.span(),
+                    &key("radius"),
+                    format!("must be positive, got {radius}"),
+                ));
+            }
+            scene.push(Shape::Sphere(Sphere::new(center, radius)), material);
+        }
+        "plane" => {
+            required("point", obj.point.is_some())?;
+            required("normal", obj.normal.is_some())?;
+            let point = cx.vec3(obj.point.as_ref().unwrap(), &key("point"))?;
+            let n = obj.normal.as_ref().unwrap();
+            let normal = cx.vec3(n, &key("normal"))?;
+            if !(normal.length() > 0.0) {
+                return Err(cx.error(n.span(), &key("normal"), "must not be the zero vector"));
+            }
+            scene.push(Shape::Plane(Plane::new(point, normal)), material);
+        }
+        "triangle" => {
+            required("vertices", obj.vertices.is_some())?;
+            let v = obj.vertices.as_ref().unwrap();
+            let vertices = v.get_ref().map(DVec3::from);
+            if !vertices.iter().all(|p| p.is_finite()) {
+                return Err(cx.error(v.span(), &key("vertices"), "must be finite numbers"));
+            }
+            match Triangle::new(vertices) {
+                Some(t) => scene.push(Shape::Triangle(t), material),
+                None => scene.dropped_triangles += 1,
+            }
+        }
+        "quadric" => {
+            required("coefficients", obj.coefficients.is_some())?;
+            let c = obj.coefficients.as_ref().unwrap();
+            let coefficients = *c.get_ref();
+            if !coefficients.iter().all(|x| x.is_finite()) {
+                return Err(cx.error(c.span(), &key("coefficients"), "must be ten finite numbers"));
+            }
+            if coefficients[..9].iter().all(|&x| x == 0.0) {
+                return Err(cx.error(
+                    c.span(),
+                    &key("coefficients"),
+                    "A to I are all zero: no surface",
+                ));
+            }
+            let clip = match &obj.clip {
+                None => None,
+                Some(clip) => {
+                    let min = cx.vec3(&clip.get_ref().min, &key("clip.min"))?;
+                    let max = cx.vec3(&clip.get_ref().max, &key("clip.max"))?;
+                    let b = Aabb::new(min, max);
+                    if b.is_empty() {
+                        return Err(cx.error(
+                            clip.span(),
+                            &key("clip"),
+                            "clip.min must not exceed clip.max",
+                        ));
+                    }
+                    Some(b)
+                }
+            };
+            scene.push(Shape::Quadric(Quadric::new(coefficients, clip)), material);
+        }
+        "mesh" => {
+            required("path", obj.path.is_some())?;
+            let p = obj.path.as_ref().unwrap();
+            let mesh_path = cx.path.parent().unwrap_or(Path::new("")).join(p.get_ref());
+            let scale = match &obj.scale {
+                Some(s) => {
+                    let x = cx.finite(s, &key("scale"))?;
+                    if x <= 0.0 {
+                        return Err(cx.error(s.span(), &key("scale"), "must be positive"));
+                    }
+                    x
+                }
+                None => 1.0,
+            };
+            let placement = Placement {
+                scale,
+                rotate_degrees: obj
+                    .rotate
+                    .as_ref()
+                    .map_or(Ok(DVec3::ZERO), |v| cx.vec3(v, &key("rotate")))?,
+                translate: obj
+                    .translate
+                    .as_ref()
+                    .map_or(Ok(DVec3::ZERO), |v| cx.vec3(v, &key("translate")))?,
+            };
+            let mesh_error = |message: String| SceneError::Mesh {
+                location: cx.location(p.span(), &key("path")),
+                mesh: mesh_path.clone(),
+                message,
+            };
+            let bytes = files
+                .read(&mesh_path)
+                .map_err(|e| mesh_error(format!("cannot read: {e}")))?;
+            let mesh = parse_obj(
+                &bytes,
+                obj.smooth.as_ref().map(|s| *s.get_ref()),
+                &placement,
+            )
+            .map_err(mesh_error)?;
+            push_mesh(scene, mesh.triangles, mesh.normals, material);
+        }
+        _ => unreachable!("kinds were checked above"),
+    }
+    Ok(())
+}
+
+/// Adds triangles (with optional per-triangle vertex normals), dropping
+/// degenerate ones.
+pub(crate) fn push_mesh(
+    scene: &mut Scene,
+    triangles: Vec<[DVec3; 3]>,
+    normals: Option<Vec<[DVec3; 3]>>,
+    material: u32,
+) {
+    for (i, vertices) in triangles.into_iter().enumerate() {
+        let Some(mut t) = Triangle::new(vertices) else {
+            scene.dropped_triangles += 1;
+            continue;
+        };
+        if let Some(n) = normals.as_ref().map(|n| n[i])
+            && n.iter().all(|v| v.is_finite() && v.length_squared() > 0.0)
+        {
+            t.vertex_normals = scene.vertex_normals.len() as u32;
+            scene.vertex_normals.push(n);
+        }
+        scene.push(Shape::Triangle(t), material);
+    }
+}
+
+/// The dotted key path at a byte offset, found from the table header and the
+/// `key =` before it (toml reports spans, not keys).
+fn key_at(text: &str, offset: usize) -> String {
+    let offset = text.floor_char_boundary(offset.min(text.len()));
+    let before = &text[..offset];
+    let mut table = String::new();
+    let mut key = String::new();
+    for line in before.lines() {
+        let l = line.trim();
+        if l.starts_with('[') {
+            table = l.trim_matches(|c| c == '[' || c == ']').trim().to_owned();
+            key.clear();
+        } else if let Some((k, _)) = l.split_once('=') {
+            key = k.trim().to_owned();
+        }
+    }
+    // A span that starts at a key (an unknown field) names that key.
+    let rest = &text[offset..];
+    let ident_len = rest
+        .find(|c: char| !(c.is_alphanumeric() || c == '_' || c == '-'))
+        .unwrap_or(rest.len());
+    let at_line_start = before
+        .rsplit('\n')
+        .next()
+        .is_none_or(|l| l.trim().is_empty());
+    if at_line_start && rest.starts_with('[') {
+        let header = rest.lines().next().unwrap_or("");
+        return header
+            .trim()
+            .trim_matches(|c| c == '[' || c == ']')
+            .trim()
+            .to_owned();
+    }
+    if ident_len > 0 && rest[ident_len..].trim_start().starts_with('=') {
+        key = rest[..ident_len].to_owned();
+    } else if let Some(eq) = before.rfind('=') {
+        // Inside an inline table the innermost `key =` is the one at fault.
+        let head = &before[..eq];
+        let start = head
+            .rfind(|c: char| c == '{' || c == ',' || c == '\n')
+            .map_or(0, |i| i + 1);
+        let inner = head[start..].trim();
+        if !inner.is_empty() && !inner.contains(['[', ']']) {
+            key = inner.to_owned();
+        }
+    }
+    match (table.is_empty(), key.is_empty()) {
+        (true, true) => "(top level)".into(),
+        (true, false) => key,
+        (false, true) => table,
+        (false, false) => format!("{table}.{key}"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::FileSystem;
+
+    const GOOD: &str = r#"
+[camera]
+eye = [0, 0, 5]
+lookat = [0, 0, 0]
+up = [0, 1, 0]
+fov = 45
+
+[materials.red]
+color = [1, 0, 0]
+
+[[lights]]
+position = [5, 5, 5]
+
+[[objects]]
+kind = "sphere"
+material = "red"
+center = [0, 0, 0]
+radius = 1
+"#;
+
+    fn parse_str(text: &str) -> Result<Scene, SceneError> {
+        parse(text, Path::new("test.toml"), &FileSystem)
+    }
+
+    fn error_of(text: &str) -> String {
+        match parse_str(text) {
+            Ok(_) => panic!("expected an error"),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    #[test]
+    fn good_scene_parses_with_defaults() {
+        let s = parse_str(GOOD).unwrap();
+        assert_eq!(s.shapes.len(), 1);
+        assert_eq!(s.image, ImageSettings::default());
+        assert_eq!(s.lights[0].color, DVec3::ONE);
+        assert_eq!(s.materials[0].kd, Material::default().kd);
+    }
+
+    #[test]
+    fn errors_name_file_line_column_and_key() {
+        let cases: &[(&str, &str, &str)] = &[
+            (
+                "radius = 1",
+                "radius = -1",
+                "test.toml:18:10: `objects[0].radius`: must be positive",
+            ),
+            (
+                "radius = 1",
+                "radius = nan",
+                "test.toml:18:10: `objects[0].radius`: must be a finite number",
+            ),
+            (
+                "radius = 1",
+                "radius = \"big\"",
+                "test.toml:18:10: `objects.radius`",
+            ),
+            (
+                "radius = 1",
+                "radius = 1\nsize = 3",
+                "test.toml:19:1: `objects.size`",
+            ),
+            (
+                "material = \"red\"",
+                "material = \"blue\"",
+                "test.toml:16:12: `objects[0].material`: no material named `blue`",
+            ),
+            (
+                "kind = \"sphere\"",
+                "kind = \"cube\"",
+                "test.toml:15:8: `objects[0].kind`: unknown kind",
+            ),
+            ("fov = 45", "fov = 180", "test.toml:6:7: `camera.fov`"),
+            (
+                "fov = 45",
+                "fov = inf",
+                "test.toml:6:7: `camera.fov`: must be a finite number",
+            ),
+            (
+                "color = [1, 0, 0]",
+                "color = [1, 0]",
+                "test.toml:9:9: `materials.red.color`",
+            ),
+            (
+                "color = [1, 0, 0]",
+                "color = [1, -1, 0]",
+                "test.toml:9:9: `materials.red.color`: colour components",
+            ),
+            (
+                "radius = 1",
+                "radius = 1\nnormal = [0, 1, 0]",
+                "test.toml:19:10: `objects[0].normal`: `normal` does not apply to a sphere",
+            ),
+            (
+                "center = [0, 0, 0]\n",
+                "",
+                "test.toml:15:8: `objects[0].center`: a sphere needs `center`",
+            ),
+            (
+                "[camera]",
+                "[camera]\nzoom = 2",
+                "test.toml:3:1: `camera.zoom`",
+            ),
+            ("eye = [0, 0, 5]\n", "", "`camera`"),
+        ];
+        for (from, to, expected) in cases {
+            let text = GOOD.replacen(from, to, 1);
+            let message = error_of(&text);
+            assert!(
+                message.contains(expected),
+                "for {to:?}:\n  got      {message}\n  expected {expected}"
+            );
+        }
+    }
+
+    #[test]
+    fn image_limits_are_checked() {
+        let with_image = |s: &str| format!("{GOOD}\n[image]\n{s}\n");
+        assert!(
+            error_of(&with_image("width = 0")).contains("`image.width`: must be an integer from 1")
+        );
+        assert!(error_of(&with_image("samples = 4")).contains("`image.samples`: must be 1 or 16"));
+        assert!(error_of(&with_image("max_depth = 1000")).contains("`image.max_depth`"));
+        let s = parse_str(&with_image(
+            "width = 20\nheight = 10\nsamples = 1\nbackground = [0.5, 0.5, 0.5]",
+        ))
+        .unwrap();
+        assert_eq!(
+            (s.image.width, s.image.height, s.image.samples),
+            (20, 10, 1)
+        );
+    }
+
+    #[test]
+    fn missing_mesh_file_names_the_path() {
+        let text = GOOD.replacen(
+            "kind = \"sphere\"\nmaterial = \"red\"\ncenter = [0, 0, 0]\nradius = 1",
+            "kind = \"mesh\"\nmaterial = \"red\"\npath = \"nowhere.obj\"",
+            1,
+        );
+        let message = error_of(&text);
+        assert!(
+            message.contains("test.toml:17:8: `objects[0].path`: mesh nowhere.obj: cannot read"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn degenerate_triangles_are_dropped_and_counted() {
+        let text = GOOD.replacen(
+            "kind = \"sphere\"\nmaterial = \"red\"\ncenter = [0, 0, 0]\nradius = 1",
+            "kind = \"triangle\"\nmaterial = \"red\"\nvertices = [[0, 0, 0], [1, 1, 1], [2, 2, 2]]",
+            1,
+        );
+        let s = parse_str(&text).unwrap();
+        assert_eq!((s.shapes.len(), s.dropped_triangles), (0, 1));
+    }
+}

@@ -1,0 +1,133 @@
+use super::{ShapeHit, Surface};
+use crate::math::{Aabb, DVec3, Ray, solve_quadratic_half};
+
+/// Open truncated cone (or cylinder) between two disks, without end caps:
+/// NFF's `c` primitive. The radius varies linearly from `base_radius` at
+/// `base` to `apex_radius` at `apex`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Cone {
+    pub base: DVec3,
+    pub base_radius: f64,
+    pub apex: DVec3,
+    pub apex_radius: f64,
+    /// Unit axis from base to apex, its length and the radius slope.
+    axis: DVec3,
+    height: f64,
+    slope: f64,
+}
+
+impl Cone {
+    /// `None` if base and apex coincide or a value is not finite.
+    pub fn new(base: DVec3, base_radius: f64, apex: DVec3, apex_radius: f64) -> Option<Self> {
+        let span = apex - base;
+        let height = span.length();
+        if !(height > 0.0
+            && height.is_finite()
+            && base_radius.is_finite()
+            && apex_radius.is_finite())
+        {
+            return None;
+        }
+        let (base_radius, apex_radius) = (base_radius.abs(), apex_radius.abs());
+        Some(Self {
+            base,
+            base_radius,
+            apex,
+            apex_radius,
+            axis: span / height,
+            height,
+            slope: (apex_radius - base_radius) / height,
+        })
+    }
+
+    /// Points `q` (relative to `base`) satisfy `|q_perp|^2 = (r0 + s z)^2`
+    /// with `z = q . axis`; the perpendicular parts are formed explicitly so
+    /// nothing cancels for rays that start far away.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<ShapeHit> {
+        let o = ray.origin - self.base;
+        let (oz, dz) = (o.dot(self.axis), ray.dir.dot(self.axis));
+        let o_perp = o - oz * self.axis;
+        let d_perp = ray.dir - dz * self.axis;
+        let r_o = self.base_radius + self.slope * oz;
+        let a = d_perp.length_squared() - self.slope * self.slope * dz * dz;
+        let h = o_perp.dot(d_perp) - self.slope * dz * r_o;
+        let c = o_perp.length_squared() - r_o * r_o;
+        let (t0, t1) = solve_quadratic_half(a, h, c)?;
+        [t0, t1]
+            .into_iter()
+            .find(|&t| {
+                let z = oz + t * dz;
+                t > 0.0
+                    && t < t_max
+                    && z >= 0.0
+                    && z <= self.height
+                    && self.base_radius + self.slope * z >= 0.0
+            })
+            .map(ShapeHit::at)
+    }
+
+    pub fn surface(&self, ray: &Ray, hit: &ShapeHit) -> Surface {
+        let p = ray.at(hit.t);
+        let q = p - self.base;
+        let z = q.dot(self.axis);
+        let q_perp = q - z * self.axis;
+        let r = self.base_radius + self.slope * z;
+        let radial = super::unit_or_none(q_perp);
+        // Re-project onto the surface radially, then take the gradient
+        // `q_perp - r s axis` (up to a factor), which vanishes only at an apex.
+        let point = radial.map_or(p, |u| self.base + z * self.axis + r.max(0.0) * u);
+        let normal = radial
+            .and_then(|u| super::unit_or_none(u - self.slope * self.axis))
+            .unwrap_or(-ray.dir);
+        Surface {
+            point,
+            geometric_normal: normal,
+            shading_normal: normal,
+        }
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        // A disk of radius r with unit normal a extends r sqrt(1 - a_k^2) along axis k.
+        let spread = (DVec3::ONE - self.axis * self.axis).max(DVec3::ZERO);
+        let extent = DVec3::new(spread.x.sqrt(), spread.y.sqrt(), spread.z.sqrt());
+        let (eb, ea) = (extent * self.base_radius, extent * self.apex_radius);
+        Aabb::new(self.base - eb, self.base + eb).union(Aabb::new(self.apex - ea, self.apex + ea))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cylinder_hit_from_outside_and_inside() {
+        let c = Cone::new(DVec3::ZERO, 1.0, DVec3::new(0.0, 0.0, 2.0), 1.0).unwrap();
+        let outside = Ray::new(DVec3::new(-5.0, 0.0, 1.0), DVec3::X);
+        let h = c.intersect(&outside, f64::INFINITY).unwrap();
+        assert!((h.t - 4.0).abs() < 1e-12);
+        let s = c.surface(&outside, &h);
+        assert!((s.geometric_normal - -DVec3::X).length() < 1e-12);
+        let inside = Ray::new(DVec3::new(0.0, 0.0, 1.0), DVec3::Y);
+        assert!((c.intersect(&inside, f64::INFINITY).unwrap().t - 1.0).abs() < 1e-12);
+        let past_end = Ray::new(DVec3::new(-5.0, 0.0, 2.5), DVec3::X);
+        assert!(c.intersect(&past_end, f64::INFINITY).is_none());
+    }
+
+    #[test]
+    fn cone_radius_varies_and_bounds_contain_rims() {
+        let c = Cone::new(DVec3::ZERO, 1.0, DVec3::new(0.0, 0.0, 1.0), 0.0).unwrap();
+        // At z = 0.5 the radius is 0.5.
+        let r = Ray::new(DVec3::new(-5.0, 0.0, 0.5), DVec3::X);
+        assert!((c.intersect(&r, f64::INFINITY).unwrap().t - 4.5).abs() < 1e-12);
+        let tilted = Cone::new(DVec3::ZERO, 0.5, DVec3::new(1.0, 2.0, 3.0), 0.2).unwrap();
+        let b = tilted.bounds().padded(1e-12);
+        for k in 0..64 {
+            let a = k as f64 / 64.0 * std::f64::consts::TAU;
+            let (e1, e2) = crate::math::orthonormal_basis(tilted.axis);
+            let rim = a.cos() * e1 + a.sin() * e2;
+            assert!(b.contains(tilted.base + 0.5 * rim) && b.contains(tilted.apex + 0.2 * rim));
+        }
+        assert!(Cone::new(DVec3::ONE, 1.0, DVec3::ONE, 1.0).is_none());
+    }
+}

@@ -1,0 +1,157 @@
+//! The closed set of shapes glint renders. Dispatch is a `match` on [`Shape`],
+//! never a trait object, so the hot intersection loop inlines.
+
+mod cone;
+mod plane;
+mod quadric;
+mod sphere;
+mod triangle;
+
+pub use cone::Cone;
+pub use plane::Plane;
+pub use quadric::Quadric;
+pub use sphere::Sphere;
+pub use triangle::{Triangle, triangle_overlaps_box};
+
+use crate::math::{Aabb, DVec3, Ray};
+
+/// A ray prepared once for many intersection tests: the watertight triangle
+/// test's shear constants (Woop, Benthin & Wald 2013) are computed here.
+#[derive(Clone, Copy, Debug)]
+pub struct PreparedRay {
+    pub ray: Ray,
+    /// Axis of the largest direction component, and the two others.
+    kx: usize,
+    ky: usize,
+    kz: usize,
+    shear: DVec3,
+}
+
+impl PreparedRay {
+    pub fn new(ray: Ray) -> Self {
+        let d = ray.dir;
+        let a = d.abs();
+        let kz = if a.x >= a.y && a.x >= a.z {
+            0
+        } else if a.y >= a.z {
+            1
+        } else {
+            2
+        };
+        let mut kx = (kz + 1) % 3;
+        let mut ky = (kx + 1) % 3;
+        // Keep the winding of the projected triangle independent of the sign.
+        if d[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        let shear = DVec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
+        Self {
+            ray,
+            kx,
+            ky,
+            kz,
+            shear,
+        }
+    }
+}
+
+/// The parameter of a hit and what the shape needs to rebuild the surface
+/// point there (barycentric coordinates of vertices 1 and 2 for triangles).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShapeHit {
+    pub t: f64,
+    pub b1: f64,
+    pub b2: f64,
+}
+
+impl ShapeHit {
+    fn at(t: f64) -> Self {
+        Self {
+            t,
+            b1: 0.0,
+            b2: 0.0,
+        }
+    }
+}
+
+/// Where a ray met a surface.
+#[derive(Clone, Copy, Debug)]
+pub struct Surface {
+    pub point: DVec3,
+    /// Unit geometric normal, on the shape's outside (for triangles the side
+    /// from which the vertices run counter-clockwise).
+    pub geometric_normal: DVec3,
+    /// Unit normal used for shading (interpolated on smooth meshes).
+    pub shading_normal: DVec3,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shape {
+    Sphere(Sphere),
+    Plane(Plane),
+    Triangle(Triangle),
+    Quadric(Quadric),
+    Cone(Cone),
+}
+
+impl Shape {
+    /// Closest hit with `0 < t < t_max`.
+    #[inline]
+    pub fn intersect(&self, ray: &PreparedRay, t_max: f64) -> Option<ShapeHit> {
+        match self {
+            Shape::Sphere(s) => s.intersect(&ray.ray, t_max),
+            Shape::Plane(p) => p.intersect(&ray.ray, t_max),
+            Shape::Triangle(t) => t.intersect(ray, t_max),
+            Shape::Quadric(q) => q.intersect(&ray.ray, t_max),
+            Shape::Cone(c) => c.intersect(&ray.ray, t_max),
+        }
+    }
+
+    /// The surface point of a hit found by [`Shape::intersect`] with `ray`.
+    pub fn surface(&self, ray: &Ray, hit: &ShapeHit, vertex_normals: &[[DVec3; 3]]) -> Surface {
+        match self {
+            Shape::Sphere(s) => s.surface(ray, hit),
+            Shape::Plane(p) => p.surface(ray, hit),
+            Shape::Triangle(t) => t.surface(hit, vertex_normals),
+            Shape::Quadric(q) => q.surface(ray, hit),
+            Shape::Cone(c) => c.surface(ray, hit),
+        }
+    }
+
+    /// Bounding box, `None` for unbounded shapes (planes, unclipped quadrics).
+    pub fn bounds(&self) -> Option<Aabb> {
+        match self {
+            Shape::Sphere(s) => Some(s.bounds()),
+            Shape::Plane(_) => None,
+            Shape::Triangle(t) => Some(t.bounds()),
+            Shape::Quadric(q) => q.clip,
+            Shape::Cone(c) => Some(c.bounds()),
+        }
+    }
+
+    /// Whether the shape may touch the closed box `b`: exact for triangles
+    /// and spheres, by bounding box otherwise. Never false when it does touch.
+    pub fn overlaps_box(&self, b: &Aabb) -> bool {
+        match self {
+            Shape::Sphere(s) => s.overlaps_box(b),
+            Shape::Triangle(t) => triangle_overlaps_box(&t.vertices, b),
+            _ => self.bounds().is_none_or(|sb| sb.overlaps(b)),
+        }
+    }
+
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            Shape::Sphere(_) => "sphere",
+            Shape::Plane(_) => "plane",
+            Shape::Triangle(_) => "triangle",
+            Shape::Quadric(_) => "quadric",
+            Shape::Cone(_) => "cone",
+        }
+    }
+}
+
+/// The unit gradient direction, or `None` where it vanishes (a cone's apex).
+fn unit_or_none(v: DVec3) -> Option<DVec3> {
+    let len = v.length();
+    (len > 0.0 && len.is_finite()).then(|| v / len)
+}

@@ -1,0 +1,196 @@
+use super::{ShapeHit, Surface};
+use crate::math::{Aabb, DVec3, Ray, solve_quadratic_half};
+
+/// General quadric surface
+/// `F(x,y,z) = A x^2 + B xy + C xz + D x + E y^2 + F yz + G y + H z^2 + I z + J = 0`,
+/// optionally clipped to an axis-aligned box.
+///
+/// The coefficients carry no implicit factors of 2: the cross terms `B xy`,
+/// `C xz`, `F yz` and the linear terms `D x`, `G y`, `I z` appear exactly as
+/// written. Substituting the ray `o + t d` gives `Aq t^2 + Bq t + Cq = 0`
+/// with `Aq = Q(d)`, `Bq = grad F(o) . d` and `Cq = F(o)`, where `Q` is the
+/// quadratic part; the normal is `grad F`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Quadric {
+    /// `[A, B, C, D, E, F, G, H, I, J]`.
+    pub coefficients: [f64; 10],
+    pub clip: Option<Aabb>,
+}
+
+impl Quadric {
+    pub fn new(coefficients: [f64; 10], clip: Option<Aabb>) -> Self {
+        Self { coefficients, clip }
+    }
+
+    /// `F(p)`.
+    pub fn value(&self, p: DVec3) -> f64 {
+        let [a, b, c, d, e, f, g, h, i, j] = self.coefficients;
+        let (x, y, z) = (p.x, p.y, p.z);
+        x * (a * x + b * y + c * z + d) + y * (e * y + f * z + g) + z * (h * z + i) + j
+    }
+
+    /// `grad F(p)`.
+    pub fn gradient(&self, p: DVec3) -> DVec3 {
+        let [a, b, c, d, e, f, g, h, i, _] = self.coefficients;
+        let (x, y, z) = (p.x, p.y, p.z);
+        DVec3::new(
+            2.0 * a * x + b * y + c * z + d,
+            b * x + 2.0 * e * y + f * z + g,
+            c * x + f * y + 2.0 * h * z + i,
+        )
+    }
+
+    /// The quadratic part `Q(d)`.
+    fn quadratic_form(&self, d: DVec3) -> f64 {
+        let [a, b, c, _, e, f, _, h, _, _] = self.coefficients;
+        d.x * (a * d.x + b * d.y + c * d.z) + d.y * (e * d.y + f * d.z) + h * d.z * d.z
+    }
+
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<ShapeHit> {
+        let mut t_lo = 0.0;
+        let mut t_hi = t_max;
+        if let Some(clip) = &self.clip {
+            (t_lo, t_hi) = clip.ray_range(ray, 0.0, t_max)?;
+        }
+        let aq = self.quadratic_form(ray.dir);
+        let half_bq = 0.5 * self.gradient(ray.origin).dot(ray.dir);
+        let cq = self.value(ray.origin);
+        // `Aq == 0` (a line parallel to a paraboloid's axis, a plane) is the
+        // linear case, handled inside the solver; tiny `Aq` is handled by the
+        // stable `c / q` root.
+        let (t0, t1) = solve_quadratic_half(aq, half_bq, cq)?;
+        [t0, t1]
+            .into_iter()
+            .find(|&t| {
+                t > 0.0 && t < t_max && t >= t_lo && t <= t_hi && self.inside_clip(ray.at(t))
+            })
+            .map(ShapeHit::at)
+    }
+
+    fn inside_clip(&self, p: DVec3) -> bool {
+        self.clip.is_none_or(|c| c.contains(p))
+    }
+
+    pub fn surface(&self, ray: &Ray, hit: &ShapeHit) -> Surface {
+        let mut point = ray.at(hit.t);
+        // One Newton step along the ray moves the point onto the surface to
+        // within rounding, so secondary rays start from an accurate point.
+        let slope = self.gradient(point).dot(ray.dir);
+        if slope != 0.0 {
+            let refined = point - (self.value(point) / slope) * ray.dir;
+            if refined.is_finite() && self.value(refined).abs() <= self.value(point).abs() {
+                point = refined;
+            }
+        }
+        // The gradient vanishes at a cone's apex: any normal is as good as
+        // another there, so face the ray.
+        let normal = super::unit_or_none(self.gradient(point)).unwrap_or(-ray.dir);
+        Surface {
+            point,
+            geometric_normal: normal,
+            shading_normal: normal,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shapes::Sphere;
+
+    fn sphere_quadric(c: DVec3, r: f64) -> Quadric {
+        // (x-cx)^2 + (y-cy)^2 + (z-cz)^2 - r^2
+        Quadric::new(
+            [
+                1.0,
+                0.0,
+                0.0,
+                -2.0 * c.x,
+                1.0,
+                0.0,
+                -2.0 * c.y,
+                1.0,
+                -2.0 * c.z,
+                c.length_squared() - r * r,
+            ],
+            None,
+        )
+    }
+
+    #[test]
+    fn sphere_form_matches_analytic_sphere() {
+        let c = DVec3::new(0.3, -0.2, 0.1);
+        let q = sphere_quadric(c, 0.7);
+        let s = Sphere::new(c, 0.7);
+        for k in 0..200 {
+            let a = k as f64 * 0.1;
+            let dir = DVec3::new(a.cos() * 0.3, a.sin() * 0.3, -1.0).normalize();
+            let ray = Ray::new(DVec3::new(0.0, 0.0, 3.0), dir);
+            let (hq, hs) = (
+                q.intersect(&ray, f64::INFINITY),
+                s.intersect(&ray, f64::INFINITY),
+            );
+            assert_eq!(hq.is_some(), hs.is_some(), "ray {k}");
+            if let (Some(hq), Some(hs)) = (hq, hs) {
+                assert!((hq.t - hs.t).abs() < 1e-12, "ray {k}: {} vs {}", hq.t, hs.t);
+                let nq = q.surface(&ray, &hq).geometric_normal;
+                let ns = s.surface(&ray, &hs).geometric_normal;
+                assert!((nq - ns).length() < 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn scaling_coefficients_changes_nothing_but_normal_length() {
+        let q = sphere_quadric(DVec3::ZERO, 1.0);
+        let ray = Ray::new(DVec3::new(0.2, 0.1, 4.0), -DVec3::Z);
+        let base = q.intersect(&ray, f64::INFINITY).unwrap();
+        for scale in [1e-8, -3.0, 1e8] {
+            let scaled = Quadric::new(q.coefficients.map(|c| c * scale), None);
+            let h = scaled.intersect(&ray, f64::INFINITY).unwrap();
+            assert!((h.t - base.t).abs() < 1e-14, "scale {scale}");
+            // Negating F flips the gradient: the outside is where F > 0.
+            let n = scaled.surface(&ray, &h).geometric_normal;
+            assert!((n.z.abs() - q.surface(&ray, &base).geometric_normal.z).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn linear_case_paraboloid_along_axis() {
+        // z = x^2 + y^2, i.e. x^2 + y^2 - z = 0; a ray along -z has Aq = 0.
+        let q = Quadric::new([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1.0, 0.0], None);
+        let ray = Ray::new(DVec3::new(0.5, 0.5, 10.0), -DVec3::Z);
+        let h = q.intersect(&ray, f64::INFINITY).unwrap();
+        assert!((h.t - 9.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn clipped_cylinder_and_miss_outside_clip() {
+        // x^2 + y^2 - 1 = 0, clipped to |z| <= 1.
+        let clip = Aabb::new(DVec3::new(-1.0, -1.0, -1.0), DVec3::new(1.0, 1.0, 1.0));
+        let q = Quadric::new(
+            [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, -1.0],
+            Some(clip),
+        );
+        let hit = Ray::new(DVec3::new(-5.0, 0.0, 0.5), DVec3::X);
+        assert_eq!(q.intersect(&hit, f64::INFINITY).map(|h| h.t), Some(4.0));
+        let above = Ray::new(DVec3::new(-5.0, 0.0, 1.5), DVec3::X);
+        assert!(q.intersect(&above, f64::INFINITY).is_none());
+        // Seen from inside the open tube, the far wall is hit.
+        let inside = Ray::new(DVec3::new(0.0, 0.0, 0.5), DVec3::X);
+        assert_eq!(q.intersect(&inside, f64::INFINITY).map(|h| h.t), Some(1.0));
+    }
+
+    #[test]
+    fn cone_apex_gives_finite_normal() {
+        // x^2 + y^2 - z^2 = 0: the apex is at the origin.
+        let q = Quadric::new([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, -1.0, 0.0, 0.0], None);
+        let ray = Ray::new(DVec3::new(0.0, -2.0, 0.0), DVec3::Y);
+        let h = q.intersect(&ray, f64::INFINITY).unwrap();
+        assert!((h.t - 2.0).abs() < 1e-6, "{}", h.t);
+        let s = q.surface(&ray, &h);
+        assert!(s.geometric_normal.is_finite());
+        assert!((s.geometric_normal.length() - 1.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,229 @@
+use super::{PreparedRay, ShapeHit, Surface};
+use crate::math::{Aabb, DVec3};
+
+/// Marker for "no vertex normals": the triangle is flat shaded.
+pub const NO_NORMALS: u32 = u32::MAX;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Triangle {
+    pub vertices: [DVec3; 3],
+    /// Unit geometric normal (counter-clockwise winding faces it).
+    pub normal: DVec3,
+    /// Index into the scene's per-triangle vertex normals, or [`NO_NORMALS`].
+    pub vertex_normals: u32,
+}
+
+impl Triangle {
+    /// `None` for degenerate triangles (zero area, collinear or repeated
+    /// vertices, non-finite coordinates): they can never be hit, so glint
+    /// drops them at load instead of testing them for every ray.
+    pub fn new(vertices: [DVec3; 3]) -> Option<Self> {
+        let [a, b, c] = vertices;
+        if !(a.is_finite() && b.is_finite() && c.is_finite()) {
+            return None;
+        }
+        let (e1, e2) = (b - a, c - a);
+        let cross = e1.cross(e2);
+        let len = cross.length();
+        // Relative to the edges: the sine of the angle at vertex 0.
+        if !(len > 1e-12 * e1.length() * e2.length()) {
+            return None;
+        }
+        Some(Self {
+            vertices,
+            normal: cross / len,
+            vertex_normals: NO_NORMALS,
+        })
+    }
+
+    /// Watertight ray/triangle intersection: Woop, Benthin & Wald,
+    /// "Watertight Ray/Triangle Intersection", JCGT 2(1), 2013. Rays through
+    /// a shared edge or vertex hit at least one of the triangles that share it.
+    #[inline]
+    pub fn intersect(&self, r: &PreparedRay, t_max: f64) -> Option<ShapeHit> {
+        let o = r.ray.origin;
+        let (kx, ky, kz, s) = (r.kx, r.ky, r.kz, r.shear);
+        let a = self.vertices[0] - o;
+        let b = self.vertices[1] - o;
+        let c = self.vertices[2] - o;
+        let (ax, ay) = (a[kx] - s.x * a[kz], a[ky] - s.y * a[kz]);
+        let (bx, by) = (b[kx] - s.x * b[kz], b[ky] - s.y * b[kz]);
+        let (cx, cy) = (c[kx] - s.x * c[kz], c[ky] - s.y * c[kz]);
+        let u = cx * by - cy * bx;
+        let v = ax * cy - ay * cx;
+        let w = bx * ay - by * ax;
+        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+            return None;
+        }
+        let det = u + v + w;
+        if det == 0.0 {
+            return None;
+        }
+        let t_scaled = s.z * (u * a[kz] + v * b[kz] + w * c[kz]);
+        let t = t_scaled / det;
+        if !(t > 0.0 && t < t_max) {
+            return None;
+        }
+        Some(ShapeHit {
+            t,
+            b1: v / det,
+            b2: w / det,
+        })
+    }
+
+    pub fn surface(&self, hit: &ShapeHit, vertex_normals: &[[DVec3; 3]]) -> Surface {
+        let b0 = 1.0 - hit.b1 - hit.b2;
+        let [v0, v1, v2] = self.vertices;
+        // Interpolating the vertices gives a point whose error is bounded by
+        // the vertices' magnitude (Wächter & Binder, RTG ch. 6).
+        let point = b0 * v0 + hit.b1 * v1 + hit.b2 * v2;
+        let shading_normal = vertex_normals
+            .get(self.vertex_normals as usize)
+            .and_then(|[n0, n1, n2]| super::unit_or_none(b0 * *n0 + hit.b1 * *n1 + hit.b2 * *n2))
+            .unwrap_or(self.normal);
+        Surface {
+            point,
+            geometric_normal: self.normal,
+            shading_normal,
+        }
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        Aabb::from_points(&self.vertices)
+    }
+}
+
+/// Exact triangle/box overlap by the separating axis theorem
+/// (Akenine-Möller, "Fast 3D Triangle-Box Overlap Testing", JGT 2001):
+/// the 3 box normals, the triangle normal and the 9 edge cross products.
+/// Touching counts as overlapping.
+pub fn triangle_overlaps_box(vertices: &[DVec3; 3], b: &Aabb) -> bool {
+    let center = b.center();
+    let half = 0.5 * b.extent();
+    let v = vertices.map(|p| p - center);
+    let separated_on = |axis: DVec3| -> bool {
+        let p = [v[0].dot(axis), v[1].dot(axis), v[2].dot(axis)];
+        let (lo, hi) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
+        let r = half.dot(axis.abs());
+        lo > r || hi < -r
+    };
+    let edges = [v[1] - v[0], v[2] - v[1], v[0] - v[2]];
+    for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
+        if separated_on(axis) {
+            return false;
+        }
+        for e in edges {
+            let a = axis.cross(e);
+            if a != DVec3::ZERO && separated_on(a) {
+                return false;
+            }
+        }
+    }
+    let n = edges[0].cross(edges[1]);
+    n == DVec3::ZERO || !separated_on(n)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Ray;
+
+    fn tri() -> Triangle {
+        Triangle::new([DVec3::ZERO, DVec3::X, DVec3::Y]).unwrap()
+    }
+
+    fn prepared(o: [f64; 3], d: [f64; 3]) -> PreparedRay {
+        PreparedRay::new(Ray::new(DVec3::from(o), DVec3::from(d).normalize()))
+    }
+
+    #[test]
+    fn hit_reports_barycentrics_and_point() {
+        let t = tri();
+        let h = t
+            .intersect(&prepared([0.25, 0.5, 2.0], [0.0, 0.0, -1.0]), f64::INFINITY)
+            .unwrap();
+        assert!((h.t - 2.0).abs() < 1e-15);
+        let s = t.surface(&h, &[]);
+        assert!((s.point - DVec3::new(0.25, 0.5, 0.0)).length() < 1e-15);
+        assert_eq!(s.geometric_normal, DVec3::Z);
+    }
+
+    #[test]
+    fn both_sides_hit_and_misses_miss() {
+        let t = tri();
+        assert!(
+            t.intersect(&prepared([0.2, 0.2, -1.0], [0.0, 0.0, 1.0]), f64::INFINITY)
+                .is_some()
+        );
+        assert!(
+            t.intersect(&prepared([0.6, 0.6, 1.0], [0.0, 0.0, -1.0]), f64::INFINITY)
+                .is_none()
+        );
+        assert!(
+            t.intersect(&prepared([0.2, 0.2, 1.0], [0.0, 0.0, 1.0]), f64::INFINITY)
+                .is_none()
+        );
+        // In the triangle's plane: no hit, no NaN.
+        assert!(
+            t.intersect(&prepared([-1.0, 0.2, 0.0], [1.0, 0.0, 0.0]), f64::INFINITY)
+                .is_none()
+        );
+    }
+
+    #[test]
+    fn shared_edge_is_watertight() {
+        // Two triangles sharing the diagonal of the unit square.
+        let a = Triangle::new([DVec3::ZERO, DVec3::X, DVec3::ONE.with_z(0.0)]).unwrap();
+        let b = Triangle::new([DVec3::ZERO, DVec3::ONE.with_z(0.0), DVec3::Y]).unwrap();
+        for k in 0..=100 {
+            let s = k as f64 / 100.0;
+            for d in [[0.0, 0.0, -1.0], [0.3, -0.2, -1.0], [-0.5, 0.7, -1.0]] {
+                let dir = DVec3::from(d).normalize();
+                let target = DVec3::new(s, s, 0.0);
+                let o = target - 3.0 * dir;
+                let r = PreparedRay::new(Ray::new(o, dir));
+                let hits = a.intersect(&r, f64::INFINITY).is_some() as u32
+                    + b.intersect(&r, f64::INFINITY).is_some() as u32;
+                let on_border = k == 0 || k == 100;
+                assert!(
+                    hits >= 1 || on_border,
+                    "ray through the shared edge at {s} leaked"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn degenerate_triangles_are_rejected() {
+        assert!(Triangle::new([DVec3::ZERO, DVec3::X, 2.0 * DVec3::X]).is_none());
+        assert!(Triangle::new([DVec3::ZERO, DVec3::ZERO, DVec3::Y]).is_none());
+        assert!(Triangle::new([DVec3::ZERO, DVec3::X, DVec3::NAN]).is_none());
+        assert!(Triangle::new([DVec3::ZERO, DVec3::X * 1e-4, DVec3::Y * 1e-4]).is_some());
+        assert!(Triangle::new([DVec3::ZERO, DVec3::X * 1e4, DVec3::Y * 1e4]).is_some());
+    }
+
+    #[test]
+    fn box_overlap_is_exact() {
+        let unit = Aabb::new(DVec3::ZERO, DVec3::ONE);
+        // Crosses the box's corner region diagonally without touching it.
+        let outside = [
+            DVec3::new(2.5, 0.0, 0.5),
+            DVec3::new(0.0, 2.5, 0.5),
+            DVec3::new(3.0, 3.0, 0.5),
+        ];
+        assert!(Aabb::from_points(&outside).overlaps(&unit));
+        assert!(!triangle_overlaps_box(&outside, &unit));
+        let crossing = [
+            DVec3::new(0.5, 0.5, -1.0),
+            DVec3::new(0.5, 0.5, 2.0),
+            DVec3::new(3.0, 3.0, 0.5),
+        ];
+        assert!(triangle_overlaps_box(&crossing, &unit));
+        let touching_face = [
+            DVec3::new(1.0, 0.2, 0.2),
+            DVec3::new(2.0, 0.2, 0.2),
+            DVec3::new(1.0, 0.8, 0.8),
+        ];
+        assert!(triangle_overlaps_box(&touching_face, &unit));
+    }
+}

@@ -1,0 +1,77 @@
+//! Work counters. Tracing is generic over [`Counter`]: with [`NoCounts`]
+//! every increment compiles to nothing, so counting costs only when asked for.
+
+/// Receives one call per unit of work done for a ray.
+pub trait Counter {
+    #[inline(always)]
+    fn intersection_test(&mut self) {}
+    #[inline(always)]
+    fn traversal_step(&mut self) {}
+    #[inline(always)]
+    fn leaf_visit(&mut self) {}
+}
+
+/// Counts nothing; the default.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoCounts;
+
+impl Counter for NoCounts {}
+
+/// Havran's machine-independent measures, summed over rays: intersection
+/// tests (N_IT), traversal steps, i.e. octree nodes entered (N_TS), and
+/// leaves entered (N_ETS).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WorkCounts {
+    pub intersection_tests: u64,
+    pub traversal_steps: u64,
+    pub leaves_visited: u64,
+}
+
+impl Counter for WorkCounts {
+    #[inline(always)]
+    fn intersection_test(&mut self) {
+        self.intersection_tests += 1;
+    }
+    #[inline(always)]
+    fn traversal_step(&mut self) {
+        self.traversal_steps += 1;
+    }
+    #[inline(always)]
+    fn leaf_visit(&mut self) {
+        self.leaves_visited += 1;
+    }
+}
+
+impl std::ops::AddAssign for WorkCounts {
+    fn add_assign(&mut self, o: Self) {
+        self.intersection_tests += o.intersection_tests;
+        self.traversal_steps += o.traversal_steps;
+        self.leaves_visited += o.leaves_visited;
+    }
+}
+
+/// Rays cast, by kind.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct RayCounts {
+    pub primary: u64,
+    pub primary_hits: u64,
+    pub shadow: u64,
+    pub reflection: u64,
+    pub refraction: u64,
+}
+
+impl RayCounts {
+    pub fn total(&self) -> u64 {
+        self.primary + self.shadow + self.reflection + self.refraction
+    }
+}
+
+impl std::ops::AddAssign for RayCounts {
+    fn add_assign(&mut self, o: Self) {
+        self.primary += o.primary;
+        self.primary_hits += o.primary_hits;
+        self.shadow += o.shadow;
+        self.reflection += o.reflection;
+        self.refraction += o.refraction;
+    }
+}
