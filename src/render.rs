@@ -416,6 +416,32 @@ impl<'a> Renderer<'a> {
         (out, counts)
     }
 
+    /// Traces every `every`-th row of the image (rows 0, every, 2 every, ...)
+    /// without keeping the pixels: a deterministic subset for estimating
+    /// the cost of slow configurations.
+    pub fn trace_rows(&self, every: u32, count_work: bool) -> TileCounts {
+        let rows: Vec<u32> = (0..self.settings.height)
+            .step_by(every.max(1) as usize)
+            .collect();
+        let per_row: Vec<TileCounts> = rows
+            .par_iter()
+            .map(|&y| {
+                let tile = Tile {
+                    x: 0,
+                    y,
+                    width: self.settings.width,
+                    height: 1,
+                };
+                self.render_tile(tile, count_work).1
+            })
+            .collect();
+        let mut total = TileCounts::default();
+        for c in per_row {
+            total += c;
+        }
+        total
+    }
+
     /// Renders the whole frame on the current rayon pool. `progress` is
     /// called with (tiles done, tiles total) as tiles finish.
     pub fn render(

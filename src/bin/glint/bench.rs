@@ -1,6 +1,281 @@
-use anyhow::Result;
+//! `glint bench`: octree on against off, interleaved repeats, medians.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Result, bail};
+use glint::accel::{Octree, OctreeStats};
+use glint::render::{RenderSettings, Renderer, TileCounts};
+use serde::Serialize;
+
+use crate::common::{load_scene, parse_positive, parse_samples, thread_pool};
+
 #[derive(clap::Args)]
-pub struct BenchArgs {}
-pub fn run(_a: &BenchArgs) -> Result<()> {
+pub struct BenchArgs {
+    /// Scene files (.toml or .nff).
+    #[arg(required = true)]
+    pub scenes: Vec<PathBuf>,
+    /// Image size as WIDTHxHEIGHT (default: each scene's own).
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Rays per pixel: 1 or 16 (default: each scene's own).
+    #[arg(long, value_parser = parse_samples)]
+    pub samples: Option<u32>,
+    /// Longest ray path (default: each scene's own).
+    #[arg(long, value_parser = parse_positive)]
+    pub max_depth: Option<u32>,
+    /// Timed runs of each configuration; medians are reported.
+    #[arg(long, default_value_t = 3, value_parser = parse_positive)]
+    pub repeat: u32,
+    /// Render threads (default: one per core).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    /// Output format.
+    #[arg(long, value_enum, default_value = "markdown")]
+    pub format: Format,
+    /// Brute force traces at most about this many shape tests per repeat;
+    /// beyond it, it traces an evenly spaced subset of rows (both
+    /// configurations then time the same rows, and the output says so).
+    #[arg(long, default_value_t = 4e9)]
+    pub brute_force_budget: f64,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Format {
+    Json,
+    Markdown,
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT, got `{s}`"))?;
+    Ok((parse_positive(w)?, parse_positive(h)?))
+}
+
+/// One configuration's medians.
+#[derive(Serialize)]
+struct Timing {
+    /// Seconds for the whole image (for a row subset: scaled up, see `estimated`).
+    render_s: f64,
+    mrays_per_s: f64,
+    intersection_tests_per_ray: f64,
+    traversal_steps_per_ray: f64,
+    leaves_visited_per_ray: f64,
+    estimated: bool,
+}
+
+/// The JSON record of one scene; field names are a public interface.
+#[derive(Serialize)]
+struct SceneBench {
+    scene: String,
+    shapes: usize,
+    width: u32,
+    height: u32,
+    samples: u32,
+    max_depth: u32,
+    threads: usize,
+    repeats: u32,
+    load_s: f64,
+    build_s: f64,
+    octree_stats: OctreeStats,
+    octree_on: Timing,
+    octree_off: Timing,
+    /// Brute force time over octree time, measured on the same rays.
+    speedup: f64,
+    /// Rows traced by the brute-force comparison: every n-th (1 = all).
+    compared_rows_every: u32,
+    /// Render time with work counting on over off (octree on, whole image).
+    counting_overhead: f64,
+    /// Rays per pixel the scene needs, by kind.
+    rays_total: u64,
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
+    let start = Instant::now();
+    let out = f();
+    (out, start.elapsed().as_secs_f64())
+}
+
+pub fn run(args: &BenchArgs) -> Result<()> {
+    let pool = thread_pool(args.threads)?;
+    let threads = pool.current_num_threads();
+    let mut results = Vec::new();
+    for path in &args.scenes {
+        let (scene, load_s) = load_scene(path)?;
+        let mut settings = RenderSettings::from_scene(&scene);
+        if let Some((w, h)) = args.size {
+            (settings.width, settings.height) = (w, h);
+        }
+        settings.samples = args.samples.unwrap_or(settings.samples);
+        settings.max_depth = args.max_depth.unwrap_or(settings.max_depth);
+        eprintln!(
+            "bench {} ({} shapes, {}x{}, {} spp, {} repeats)",
+            path.display(),
+            scene.shapes.len(),
+            settings.width,
+            settings.height,
+            settings.samples,
+            args.repeat
+        );
+
+        let mut build_times = Vec::new();
+        let mut octree = None;
+        for _ in 0..args.repeat {
+            let (tree, s) =
+                timed(|| pool.install(|| Octree::build(&scene.shapes, scene.octree_params)));
+            build_times.push(s);
+            octree = Some(tree);
+        }
+        let Some(octree) = octree else {
+            bail!("no repeats")
+        };
+
+        let on = RenderSettings {
+            use_octree: true,
+            ..settings
+        };
+        let off = RenderSettings {
+            use_octree: false,
+            ..settings
+        };
+        let renderer_on = Renderer::new(&scene, &octree, on)?;
+        let renderer_off = Renderer::new(&scene, &octree, off)?;
+
+        // One counted pass of each for the machine-independent figures.
+        let (counted_on, counted_s) = timed(|| pool.install(|| renderer_on.render(true, None).1));
+        let rays_total = counted_on.rays.total();
+        let pixels = settings.width as f64 * settings.height as f64;
+        let brute_tests = scene.shapes.len() as f64 * rays_total as f64;
+        let every =
+            ((brute_tests / args.brute_force_budget).ceil() as u32).clamp(1, settings.height);
+        let counted_off = pool.install(|| renderer_off.trace_rows(every, true));
+
+        // Timed passes, interleaved so drift in machine speed hits both alike.
+        let (mut full_on, mut rows_on, mut rows_off) = (Vec::new(), Vec::new(), Vec::new());
+        for r in 0..args.repeat {
+            eprintln!("  repeat {}/{}", r + 1, args.repeat);
+            full_on.push(timed(|| pool.install(|| renderer_on.render(false, None))).1);
+            if every > 1 {
+                rows_on.push(timed(|| pool.install(|| renderer_on.trace_rows(every, false))).1);
+            }
+            rows_off.push(timed(|| pool.install(|| renderer_off.trace_rows(every, false))).1);
+        }
+        let on_s = median(full_on);
+        let off_rows_s = median(rows_off);
+        let on_rows_s = if every > 1 { median(rows_on) } else { on_s };
+        let speedup = off_rows_s / on_rows_s;
+        let off_s = on_s * speedup;
+        let per_ray = |c: &TileCounts, x: u64| x as f64 / c.rays.total().max(1) as f64;
+        let timing = |c: &TileCounts, seconds: f64, rays_in_time: f64, estimated: bool| Timing {
+            render_s: seconds,
+            mrays_per_s: rays_in_time / seconds.max(1e-12) / 1e6,
+            intersection_tests_per_ray: per_ray(c, c.work.intersection_tests),
+            traversal_steps_per_ray: per_ray(c, c.work.traversal_steps),
+            leaves_visited_per_ray: per_ray(c, c.work.leaves_visited),
+            estimated,
+        };
+        let _ = pixels;
+        results.push(SceneBench {
+            scene: path.display().to_string(),
+            shapes: scene.shapes.len(),
+            width: settings.width,
+            height: settings.height,
+            samples: settings.samples,
+            max_depth: settings.max_depth,
+            threads,
+            repeats: args.repeat,
+            load_s,
+            build_s: median(build_times),
+            octree_stats: octree.stats(),
+            octree_on: timing(&counted_on, on_s, rays_total as f64, false),
+            octree_off: timing(
+                &counted_off,
+                off_rows_s,
+                counted_off.rays.total() as f64,
+                every > 1,
+            ),
+            speedup,
+            compared_rows_every: every,
+            counting_overhead: counted_s / on_s,
+            rays_total,
+        });
+        if every > 1 {
+            // Report the whole-image estimate, with throughput measured on the subset.
+            if let Some(last) = results.last_mut() {
+                last.octree_off.render_s = off_s;
+            }
+        }
+    }
+    match args.format {
+        Format::Json => println!("{}", serde_json::to_string_pretty(&results)?),
+        Format::Markdown => print!("{}", markdown(&results)),
+    }
     Ok(())
+}
+
+/// Havran's best published octree (Octree93-A, best maximum depth) on the
+/// default SPD scenes: intersection tests per ray, N_IT (Havran 1999).
+fn havran_best_nit(scene: &str) -> Option<f64> {
+    let name = std::path::Path::new(scene).file_stem()?.to_str()?;
+    Some(match name {
+        "balls" => 26.38,
+        "gears" => 65.44,
+        "mount" => 16.56,
+        "rings" => 31.81,
+        "teapot" => 47.91,
+        "tetra" => 24.08,
+        "tree" => 23.79,
+        _ => return None,
+    })
+}
+
+fn markdown(results: &[SceneBench]) -> String {
+    let mut s = String::from(
+        "| scene | shapes | size | spp | build (s) | octree on (s) | octree off (s) | speedup | Mrays/s (on) | N_IT | N_TS | N_ETS | N_IT Havran best | counting overhead |\n\
+         |---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+    );
+    for r in results {
+        let name = std::path::Path::new(&r.scene)
+            .file_name()
+            .map_or(r.scene.clone(), |n| n.to_string_lossy().into_owned());
+        let off = if r.octree_off.estimated {
+            format!(
+                "{:.2} (est., rows 1/{})",
+                r.octree_off.render_s, r.compared_rows_every
+            )
+        } else {
+            format!("{:.2}", r.octree_off.render_s)
+        };
+        let havran = havran_best_nit(&r.scene).map_or("".to_string(), |x| format!("{x:.2}"));
+        s.push_str(&format!(
+            "| {} | {} | {}x{} | {} | {:.3} | {:.3} | {} | {:.1}x | {:.2} | {:.2} | {:.2} | {:.2} | {} | {:.2}x |\n",
+            name,
+            r.shapes,
+            r.width,
+            r.height,
+            r.samples,
+            r.build_s,
+            r.octree_on.render_s,
+            off,
+            r.speedup,
+            r.octree_on.mrays_per_s,
+            r.octree_on.intersection_tests_per_ray,
+            r.octree_on.traversal_steps_per_ray,
+            r.octree_on.leaves_visited_per_ray,
+            havran,
+            r.counting_overhead,
+        ));
+    }
+    s
 }

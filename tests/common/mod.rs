@@ -1,0 +1,82 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+
+use glint::accel::Octree;
+use glint::render::{RenderSettings, Renderer, TileCounts};
+use glint::scene::Scene;
+
+pub fn repo_path(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
+}
+
+pub fn load(rel: &str) -> Scene {
+    let path = repo_path(rel);
+    glint::scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Every scene file under `scenes/` (TOML and NFF, recursively), sorted.
+pub fn all_scenes() -> Vec<String> {
+    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let p = entry.unwrap().path();
+            if p.is_dir() {
+                walk(&p, out);
+            } else if matches!(p.extension().and_then(|e| e.to_str()), Some("toml" | "nff")) {
+                out.push(p);
+            }
+        }
+    }
+    let root = repo_path("scenes");
+    let mut out = Vec::new();
+    walk(&root, &mut out);
+    out.sort();
+    out.into_iter()
+        .map(|p| {
+            p.strip_prefix(repo_path(""))
+                .unwrap()
+                .to_string_lossy()
+                .into_owned()
+        })
+        .collect()
+}
+
+/// Renders at `width` x `height` with the given overrides; returns the 8-bit
+/// image and the counts.
+pub fn render_with(
+    scene: &Scene,
+    octree: &Octree,
+    width: u32,
+    height: u32,
+    adjust: impl FnOnce(&mut RenderSettings),
+) -> (Vec<u8>, TileCounts) {
+    let mut settings = RenderSettings::from_scene(scene);
+    settings.width = width;
+    settings.height = height;
+    adjust(&mut settings);
+    let renderer = Renderer::new(scene, octree, settings).unwrap();
+    let (frame, counts) = renderer.render(false, None);
+    (frame.to_rgb8(), counts)
+}
+
+/// Number of pixels whose channels differ by more than `tolerance`, and the
+/// largest channel difference.
+pub fn diff(a: &[u8], b: &[u8], tolerance: u8) -> (usize, u8) {
+    assert_eq!(a.len(), b.len());
+    let mut count = 0;
+    let mut largest = 0;
+    for (pa, pb) in a.chunks_exact(3).zip(b.chunks_exact(3)) {
+        let d = pa
+            .iter()
+            .zip(pb)
+            .map(|(x, y)| x.abs_diff(*y))
+            .max()
+            .unwrap();
+        largest = largest.max(d);
+        if d > tolerance {
+            count += 1;
+        }
+    }
+    (count, largest)
+}

@@ -1,0 +1,160 @@
+//! The octree answers exactly what brute force answers: images are
+//! byte-identical, and random rays agree on the closest hit and on shadows.
+
+mod common;
+
+use common::{all_scenes, load, render_with};
+use glint::accel::{Occlusion, Octree, OctreeParams, closest_brute_force, occlusion_brute_force};
+use glint::math::{DVec3, Ray};
+use glint::shapes::{PreparedRay, Shape, Sphere, Triangle};
+use glint::stats::NoCounts;
+use proptest::prelude::*;
+
+#[test]
+fn octree_on_and_off_give_identical_bytes_for_every_scene() {
+    for name in all_scenes() {
+        let scene = load(&name);
+        let octree = Octree::build(&scene.shapes, scene.octree_params);
+        // Brute force over tens of thousands of shapes is slow: keep the
+        // biggest scenes small.
+        let side = if scene.shapes.len() > 20_000 { 12 } else { 40 };
+        let (on, c_on) = render_with(&scene, &octree, side, side, |s| {
+            s.samples = 1;
+            s.use_octree = true;
+        });
+        let (off, c_off) = render_with(&scene, &octree, side, side, |s| {
+            s.samples = 1;
+            s.use_octree = false;
+        });
+        let differing = on
+            .chunks_exact(3)
+            .zip(off.chunks_exact(3))
+            .filter(|(a, b)| a != b)
+            .count();
+        assert_eq!(
+            differing, 0,
+            "{name}: {differing} pixels differ between octree on and off"
+        );
+        assert_eq!(c_on.rays, c_off.rays, "{name}: different rays were cast");
+    }
+}
+
+/// Shapes for the property tests: small random triangles and spheres in
+/// the box [-4, 4]^3, some of them on the octree's split planes.
+fn shapes_strategy() -> impl Strategy<Value = Vec<Shape>> {
+    let coord = prop_oneof![4 => -4.0..4.0f64, 1 => Just(0.0), 1 => Just(2.0), 1 => Just(-2.0)];
+    let point =
+        (coord.clone(), coord.clone(), coord.clone()).prop_map(|(x, y, z)| DVec3::new(x, y, z));
+    let offset =
+        (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64).prop_map(|(x, y, z)| DVec3::new(x, y, z));
+    let triangle = (point.clone(), offset.clone(), offset)
+        .prop_filter_map("degenerate", |(a, b, c)| {
+            Triangle::new([a, a + b, a + c]).map(Shape::Triangle)
+        });
+    let sphere = (point, 0.05..0.8f64).prop_map(|(c, r)| Shape::Sphere(Sphere::new(c, r)));
+    prop::collection::vec(prop_oneof![triangle, sphere], 1..60)
+}
+
+fn ray_strategy() -> impl Strategy<Value = Ray> {
+    let comp = prop_oneof![6 => -1.0..1.0f64, 1 => Just(0.0), 1 => Just(-0.0)];
+    let origin_coord = prop_oneof![4 => -6.0..6.0f64, 1 => Just(0.0), 1 => Just(2.0)];
+    (
+        (origin_coord.clone(), origin_coord.clone(), origin_coord),
+        (comp.clone(), comp.clone(), comp),
+    )
+        .prop_filter_map("zero direction", |((ox, oy, oz), (dx, dy, dz))| {
+            let d = DVec3::new(dx, dy, dz);
+            (d.length() > 1e-3).then(|| Ray::new(DVec3::new(ox, oy, oz), d.normalize()))
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 400, ..ProptestConfig::default() })]
+
+    #[test]
+    fn closest_hit_and_shadows_match_brute_force(
+        shapes in shapes_strategy(),
+        rays in prop::collection::vec(ray_strategy(), 40),
+        max_depth in 0u32..7,
+        leaf_size in 1u32..6,
+        transparent_mask in any::<u64>(),
+        shadow_length in 0.5..20.0f64,
+    ) {
+        let params = OctreeParams { max_depth, leaf_size, cost_driven: max_depth % 2 == 0 };
+        let octree = Octree::build(&shapes, params);
+        let is_transparent: Vec<bool> = (0..shapes.len()).map(|i| transparent_mask >> (i % 64) & 1 == 1).collect();
+        for ray in rays {
+            let prepared = PreparedRay::new(ray);
+            let brute = closest_brute_force(&shapes, &prepared, f64::INFINITY, &mut NoCounts);
+            let tree = octree.closest(&shapes, &prepared, f64::INFINITY, &mut NoCounts);
+            prop_assert_eq!(brute, tree, "closest hit differs for {:?}", ray);
+            let canonical = |o: Occlusion| match o {
+                Occlusion::Transparent(mut v) => { v.sort_unstable(); v.dedup(); Occlusion::Transparent(v) }
+                other => other,
+            };
+            let b = canonical(occlusion_brute_force(&shapes, &is_transparent, &prepared, shadow_length, &mut NoCounts));
+            let t = canonical(octree.occlusion(&shapes, &is_transparent, &prepared, shadow_length, &mut NoCounts));
+            prop_assert_eq!(b, t, "shadow verdict differs for {:?}", ray);
+        }
+    }
+}
+
+/// Rays along the octree's split planes and through a node corner, in all
+/// eight direction-sign combinations, find what brute force finds.
+#[test]
+fn rays_in_split_planes_and_through_corners() {
+    // A grid of small spheres centred on the split planes of a [-4, 4]^3 root.
+    let mut shapes = Vec::new();
+    for i in -4..=4 {
+        for j in -4..=4 {
+            shapes.push(Shape::Sphere(Sphere::new(
+                DVec3::new(i as f64, j as f64, 0.0),
+                0.2,
+            )));
+            shapes.push(Shape::Sphere(Sphere::new(
+                DVec3::new(i as f64, 0.0, j as f64),
+                0.2,
+            )));
+        }
+    }
+    let octree = Octree::build(
+        &shapes,
+        OctreeParams {
+            max_depth: 6,
+            leaf_size: 1,
+            cost_driven: false,
+        },
+    );
+    let mut checked = 0;
+    for sx in [-1.0, 1.0] {
+        for sy in [-1.0, 1.0] {
+            for sz in [-1.0, 1.0] {
+                for (origin, dir) in [
+                    // Through the root's centre, a corner of all eight children.
+                    (
+                        DVec3::new(-6.0 * sx, -6.0 * sy, -6.0 * sz),
+                        DVec3::new(sx, sy, sz),
+                    ),
+                    // In the plane z = 0, along x.
+                    (
+                        DVec3::new(-6.0 * sx, 0.0, 0.0),
+                        DVec3::new(sx, 0.0, 0.0 * sz),
+                    ),
+                    // In the plane y = 0, diagonal in x and z.
+                    (
+                        DVec3::new(-6.0 * sx, 0.0, -6.0 * sz),
+                        DVec3::new(sx, 0.0 * sy, sz),
+                    ),
+                ] {
+                    let ray = PreparedRay::new(Ray::new(origin, dir.normalize()));
+                    let brute = closest_brute_force(&shapes, &ray, f64::INFINITY, &mut NoCounts);
+                    let tree = octree.closest(&shapes, &ray, f64::INFINITY, &mut NoCounts);
+                    assert_eq!(brute, tree, "origin {origin}, direction {dir}");
+                    assert!(brute.is_some(), "these rays all hit a sphere");
+                    checked += 1;
+                }
+            }
+        }
+    }
+    assert_eq!(checked, 24);
+}

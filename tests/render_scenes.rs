@@ -1,0 +1,230 @@
+//! Every scene in `scenes/` renders, with properties checked on the images.
+
+mod common;
+
+use common::{all_scenes, diff, load, render_with};
+use glint::accel::Octree;
+use glint::camera::CameraSpec;
+use glint::material::{Light, Material};
+use glint::math::DVec3;
+use glint::render::{RenderSettings, Renderer, ViewMode, linear_to_srgb};
+use glint::scene::{ImageSettings, Scene};
+use glint::shapes::{Plane, Quadric, Shape, Sphere};
+
+#[test]
+fn every_scene_renders_finite_and_non_blank() {
+    let scenes = all_scenes();
+    assert!(scenes.len() >= 9, "scenes found: {scenes:?}");
+    for name in scenes {
+        let scene = load(&name);
+        let octree = Octree::build(&scene.shapes, scene.octree_params);
+        let (image, counts) = render_with(&scene, &octree, 48, 36, |s| s.samples = 1);
+        assert_eq!(
+            counts.nonfinite_samples, 0,
+            "{name}: NaN or infinite samples"
+        );
+        assert!(counts.rays.primary_hits > 0, "{name}: nothing visible");
+        let first = &image[..3];
+        let distinct = image.chunks_exact(3).filter(|p| *p != first).count();
+        assert!(
+            distinct > 48 * 36 / 20,
+            "{name}: image is nearly uniform ({distinct} pixels differ from the corner)"
+        );
+    }
+}
+
+#[test]
+fn output_is_identical_for_any_thread_count() {
+    for name in [
+        "scenes/glass.toml",
+        "scenes/default.toml",
+        "scenes/spd/teapot.nff",
+    ] {
+        let scene = load(name);
+        let octree = Octree::build(&scene.shapes, scene.octree_params);
+        let render = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| render_with(&scene, &octree, 64, 48, |s| s.samples = 16))
+        };
+        let (one, c1) = render(1);
+        let (three, c3) = render(3);
+        assert!(one == three, "{name}: 1 and 3 threads give different bytes");
+        assert_eq!(c1, c3, "{name}: counts differ between thread counts");
+    }
+}
+
+/// A plane facing the camera, lit head-on by a light at the eye: the centre
+/// pixel is `ambient * color + kd * color * light` exactly (N.L = 1, and the
+/// highlight `ks (R.V)^n` is `ks`).
+#[test]
+fn head_on_plane_matches_the_analytic_colour() {
+    let material = Material {
+        name: "m".into(),
+        color: DVec3::new(0.5, 0.25, 0.125),
+        kd: 0.6,
+        ks: 0.1,
+        shininess: 10.0,
+        ..Material::default()
+    };
+    let mut scene = Scene {
+        name: "analytic".into(),
+        camera: CameraSpec {
+            eye: DVec3::new(0.0, 0.0, 10.0),
+            lookat: DVec3::ZERO,
+            up: DVec3::Y,
+            fov: 30.0,
+        },
+        image: ImageSettings {
+            width: 3,
+            height: 3,
+            samples: 1,
+            max_depth: 1,
+            background: DVec3::ZERO,
+            ambient: DVec3::splat(0.2),
+        },
+        octree_enabled: true,
+        octree_params: Default::default(),
+        materials: vec![material.clone()],
+        lights: vec![Light {
+            position: DVec3::new(0.0, 0.0, 10.0),
+            color: DVec3::splat(0.5),
+        }],
+        shapes: vec![],
+        shape_materials: vec![],
+        vertex_normals: vec![],
+        dropped_triangles: 0,
+    };
+    scene.push(Shape::Plane(Plane::new(DVec3::ZERO, DVec3::Z)), 0);
+    let octree = Octree::build(&scene.shapes, scene.octree_params);
+    let renderer = Renderer::new(&scene, &octree, RenderSettings::from_scene(&scene)).unwrap();
+    let (frame, _) = renderer.render(false, None);
+    let centre = frame.pixels[4];
+    let expected = 0.2 * material.color + (0.6 * material.color + DVec3::splat(0.1)) * 0.5;
+    assert!(
+        (centre - expected).length() < 1e-12,
+        "{centre} vs {expected}"
+    );
+    let bytes = frame.to_rgb8();
+    let srgb = |x: f64| (linear_to_srgb(x) * 255.0).round() as u8;
+    assert_eq!(
+        &bytes[12..15],
+        &[srgb(expected.x), srgb(expected.y), srgb(expected.z)]
+    );
+}
+
+/// The quadric `x^2 + y^2 + z^2 - r^2` and the analytic sphere render the
+/// same image: at most 0.2% of pixels may differ, by at most 2/255.
+#[test]
+fn quadric_sphere_renders_like_the_analytic_sphere() {
+    let mut scene = load("scenes/sphere.toml");
+    let octree = Octree::build(&scene.shapes, scene.octree_params);
+    let (analytic, _) = render_with(&scene, &octree, 160, 120, |s| s.samples = 16);
+    let Shape::Sphere(Sphere {
+        center: c,
+        radius: r,
+    }) = scene.shapes[0].clone()
+    else {
+        panic!("the first object of sphere.toml is the sphere");
+    };
+    scene.shapes[0] = Shape::Quadric(Quadric::new(
+        [
+            1.0,
+            0.0,
+            0.0,
+            -2.0 * c.x,
+            1.0,
+            0.0,
+            -2.0 * c.y,
+            1.0,
+            -2.0 * c.z,
+            c.length_squared() - r * r,
+        ],
+        None,
+    ));
+    let octree = Octree::build(&scene.shapes, scene.octree_params);
+    let (quadric, _) = render_with(&scene, &octree, 160, 120, |s| s.samples = 16);
+    let (over_one, largest) = diff(&analytic, &quadric, 0);
+    let (over_two, _) = diff(&analytic, &quadric, 2);
+    assert!(
+        over_one <= 160 * 120 / 500 && over_two == 0,
+        "{over_one} pixels differ, largest difference {largest}/255"
+    );
+}
+
+/// Anti-aliasing changes pixels only near edges: where the 1-sample image is
+/// flat over a pixel's 3x3 neighbourhood, 16 samples agree within 3/255;
+/// and it does change the edges.
+#[test]
+fn sixteen_samples_differ_from_one_only_near_edges() {
+    for name in ["scenes/sphere.toml", "scenes/quadrics.toml"] {
+        let scene = load(name);
+        let octree = Octree::build(&scene.shapes, scene.octree_params);
+        let (w, h) = (120u32, 90u32);
+        let (one, _) = render_with(&scene, &octree, w, h, |s| s.samples = 1);
+        let (sixteen, _) = render_with(&scene, &octree, w, h, |s| s.samples = 16);
+        let px = |img: &[u8], x: u32, y: u32| -> [u8; 3] {
+            let i = ((y * w + x) * 3) as usize;
+            [img[i], img[i + 1], img[i + 2]]
+        };
+        let max_diff =
+            |a: [u8; 3], b: [u8; 3]| a.iter().zip(b).map(|(x, y)| x.abs_diff(y)).max().unwrap();
+        let (mut flat, mut changed_edges) = (0, 0);
+        for y in 1..h - 1 {
+            for x in 1..w - 1 {
+                let c = px(&one, x, y);
+                let is_flat =
+                    (0..9).all(|k| max_diff(c, px(&one, x + k % 3 - 1, y + k / 3 - 1)) <= 2);
+                let d = max_diff(c, px(&sixteen, x, y));
+                if is_flat {
+                    flat += 1;
+                    assert!(
+                        d <= 3,
+                        "{name}: flat pixel ({x}, {y}) changed by {d}/255 with 16 samples"
+                    );
+                } else if d > 3 {
+                    changed_edges += 1;
+                }
+            }
+        }
+        assert!(
+            flat > (w * h / 3) as usize,
+            "{name}: only {flat} flat pixels"
+        );
+        assert!(
+            changed_edges > 20,
+            "{name}: anti-aliasing changed only {changed_edges} edge pixels"
+        );
+    }
+}
+
+#[test]
+fn normals_and_depth_views_are_as_documented() {
+    let scene = load("scenes/sphere.toml");
+    let octree = Octree::build(&scene.shapes, scene.octree_params);
+    let (w, h) = (81u32, 61u32);
+    let (normals, _) = render_with(&scene, &octree, w, h, |s| {
+        s.samples = 1;
+        s.view = ViewMode::Normals;
+    });
+    // The camera looks at the sphere's centre: the middle pixel's normal
+    // points back at the camera, (0, 0.1, 1) normalised roughly, encoded (n+1)/2.
+    let mid = ((h / 2 * w + w / 2) * 3) as usize;
+    let n =
+        [normals[mid], normals[mid + 1], normals[mid + 2]].map(|b| b as f64 / 255.0 * 2.0 - 1.0);
+    let expected = (scene.camera.eye - DVec3::new(0.0, 1.0, 0.0)).normalize();
+    assert!(
+        (DVec3::from(n) - expected).length() < 0.02,
+        "{n:?} vs {expected}"
+    );
+    let (depth, _) = render_with(&scene, &octree, w, h, |s| {
+        s.samples = 1;
+        s.view = ViewMode::Depth;
+    });
+    // Nearest is white; the sphere's front is nearer than the floor behind it.
+    assert_eq!(depth.iter().copied().max(), Some(255));
+    let far_floor = ((h / 2 - 8) * w * 3 + 3) as usize;
+    assert!(depth[mid] > depth[far_floor] || depth[far_floor] == 0);
+}
