@@ -21,3 +21,5 @@ pub mod render;
 pub mod scene;
 pub mod shapes;
 pub mod stats;
+#[cfg(feature = "gui")]
+pub mod viewer;

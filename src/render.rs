@@ -5,7 +5,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use rayon::prelude::*;
 
 use crate::accel::{ClosestHit, Occlusion, Octree, closest_brute_force, occlusion_brute_force};
-use crate::camera::{Camera, CameraError, sample_offsets};
+use crate::camera::{Camera, CameraError, CameraSpec, sample_offsets};
 use crate::math::{Color, DVec3, Ray, offset_ray_origin, reflect, refract};
 use crate::scene::Scene;
 use crate::shapes::PreparedRay;
@@ -158,6 +158,17 @@ impl<'a> Renderer<'a> {
         octree: &'a Octree,
         settings: RenderSettings,
     ) -> Result<Self, RenderError> {
+        Self::with_camera(scene, octree, settings, &scene.camera)
+    }
+
+    /// Like [`Renderer::new`], seen from `camera` instead of the scene's own
+    /// (the viewer moves the camera without touching the scene).
+    pub fn with_camera(
+        scene: &'a Scene,
+        octree: &'a Octree,
+        settings: RenderSettings,
+        camera: &CameraSpec,
+    ) -> Result<Self, RenderError> {
         if settings.samples != 1 && settings.samples != 16 {
             return Err(RenderError::Samples(settings.samples));
         }
@@ -167,7 +178,7 @@ impl<'a> Renderer<'a> {
         if settings.width as u64 * settings.height as u64 > 1 << 28 {
             return Err(RenderError::TooLarge(settings.width, settings.height));
         }
-        let camera = Camera::new(&scene.camera, settings.width, settings.height)?;
+        let camera = Camera::new(camera, settings.width, settings.height)?;
         let is_transparent = scene
             .shape_materials
             .iter()
@@ -180,7 +191,11 @@ impl<'a> Renderer<'a> {
             camera,
             offsets: sample_offsets(settings.samples),
             is_transparent,
-            floor_scale: scene.extent_bounds().max_abs().max(f64::MIN_POSITIVE),
+            floor_scale: scene
+                .extent_bounds()
+                .grow(camera.eye)
+                .max_abs()
+                .max(f64::MIN_POSITIVE),
         })
     }
 

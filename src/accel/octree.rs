@@ -20,6 +20,10 @@ use crate::math::{Aabb, DVec3};
 use crate::shapes::{PreparedRay, Shape};
 use crate::stats::Counter;
 
+/// Deepest octree level glint builds: 2^21 cells per axis is far below
+/// any useful resolution and keeps build recursion shallow.
+pub const MAX_OCTREE_DEPTH: u32 = 21;
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 pub struct OctreeParams {
     /// Deepest level a node may have; the root is level 0.
@@ -33,10 +37,13 @@ pub struct OctreeParams {
 
 impl Default for OctreeParams {
     fn default() -> Self {
+        // Chosen by `glint bench --sweep` over the seven SPD scenes
+        // (benches/octree_sweep_256.md): the lowest total render time, and
+        // within 1.25x of each scene's best configuration.
         Self {
-            max_depth: 8,
-            leaf_size: 4,
-            cost_driven: true,
+            max_depth: 10,
+            leaf_size: 8,
+            cost_driven: false,
         }
     }
 }
@@ -137,8 +144,12 @@ impl Octree {
         if bounded.is_empty() {
             return tree;
         }
-        // Pad the root so shapes on its faces lie inside.
-        tree.bounds = bounds.padded(CLASSIFY_PAD);
+        // A cube around the shapes: cells stay cubes at every level, so a
+        // ray crosses as few of them as possible (flat cells of a flat scene
+        // would be crossed by the dozen). Padded so shapes on its faces lie inside.
+        let half = DVec3::splat(0.5 * bounds.extent().max_element());
+        let c = bounds.center();
+        tree.bounds = Aabb::new(c - half, c + half).padded(CLASSIFY_PAD);
         let root = build_node(
             shapes,
             bounded,

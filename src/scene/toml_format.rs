@@ -240,7 +240,11 @@ pub fn parse(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, S
 
     let mut octree_params = OctreeParams::default();
     if let Some(v) = &file.octree.max_depth {
-        octree_params.max_depth = cx.integer(v, "octree.max_depth", 0..22)?;
+        octree_params.max_depth = cx.integer(
+            v,
+            "octree.max_depth",
+            0..crate::accel::MAX_OCTREE_DEPTH as i64 + 1,
+        )?;
     }
     if let Some(v) = &file.octree.leaf_size {
         octree_params.leaf_size = cx.integer(v, "octree.leaf_size", 1..1_000_001)?;

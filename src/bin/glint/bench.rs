@@ -8,7 +8,7 @@ use glint::accel::{Octree, OctreeStats};
 use glint::render::{RenderSettings, Renderer, TileCounts};
 use serde::Serialize;
 
-use crate::common::{load_scene, parse_positive, parse_samples, thread_pool};
+use crate::common::{OctreeArgs, load_scene, parse_positive, parse_samples, thread_pool};
 
 #[derive(clap::Args)]
 pub struct BenchArgs {
@@ -27,6 +27,8 @@ pub struct BenchArgs {
     /// Timed runs of each configuration; medians are reported.
     #[arg(long, default_value_t = 3, value_parser = parse_positive)]
     pub repeat: u32,
+    #[command(flatten)]
+    pub octree_params: OctreeArgs,
     /// Render threads (default: one per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
@@ -38,6 +40,17 @@ pub struct BenchArgs {
     /// configurations then time the same rows, and the output says so).
     #[arg(long, default_value_t = 4e9)]
     pub brute_force_budget: f64,
+    /// Instead of octree on/off, sweep the octree parameters: every
+    /// combination of these maximum depths, leaf sizes and cost-driven
+    /// on/off, octree on, one row each (medians of `--repeat` runs).
+    #[arg(long)]
+    pub sweep: bool,
+    /// Maximum depths for `--sweep`.
+    #[arg(long, value_delimiter = ',', default_value = "6,8,10,12")]
+    pub sweep_depths: Vec<u32>,
+    /// Leaf sizes for `--sweep`.
+    #[arg(long, value_delimiter = ',', default_value = "2,4,8,16")]
+    pub sweep_leaf_sizes: Vec<u32>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -78,6 +91,7 @@ struct SceneBench {
     repeats: u32,
     load_s: f64,
     build_s: f64,
+    octree_params: glint::accel::OctreeParams,
     octree_stats: OctreeStats,
     octree_on: Timing,
     octree_off: Timing,
@@ -108,11 +122,15 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
 }
 
 pub fn run(args: &BenchArgs) -> Result<()> {
+    if args.sweep {
+        return sweep(args);
+    }
     let pool = thread_pool(args.threads)?;
     let threads = pool.current_num_threads();
     let mut results = Vec::new();
     for path in &args.scenes {
-        let (scene, load_s) = load_scene(path)?;
+        let (mut scene, load_s) = load_scene(path)?;
+        args.octree_params.apply(&mut scene.octree_params);
         let mut settings = RenderSettings::from_scene(&scene);
         if let Some((w, h)) = args.size {
             (settings.width, settings.height) = (w, h);
@@ -197,6 +215,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             repeats: args.repeat,
             load_s,
             build_s: median(build_times),
+            octree_params: scene.octree_params,
             octree_stats: octree.stats(),
             octree_on: timing(&counted_on, on_s, rays_total as f64, false),
             octree_off: timing(
@@ -278,4 +297,113 @@ fn markdown(results: &[SceneBench]) -> String {
         ));
     }
     s
+}
+
+/// One row of a parameter sweep.
+#[derive(Serialize)]
+struct SweepRow {
+    scene: String,
+    octree_params: glint::accel::OctreeParams,
+    build_s: f64,
+    render_s: f64,
+    mrays_per_s: f64,
+    intersection_tests_per_ray: f64,
+    traversal_steps_per_ray: f64,
+    leaves_visited_per_ray: f64,
+    octree_stats: OctreeStats,
+}
+
+fn sweep(args: &BenchArgs) -> Result<()> {
+    let pool = thread_pool(args.threads)?;
+    let mut rows = Vec::new();
+    if args.format == Format::Markdown {
+        println!(
+            "| scene | cost-driven | max depth | leaf size | build (s) | render (s) | N_IT | N_TS | N_ETS | nodes | memory (KiB) |"
+        );
+        println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    }
+    for path in &args.scenes {
+        let (mut scene, _) = load_scene(path)?;
+        args.octree_params.apply(&mut scene.octree_params);
+        let mut settings = RenderSettings::from_scene(&scene);
+        if let Some((w, h)) = args.size {
+            (settings.width, settings.height) = (w, h);
+        }
+        settings.samples = args.samples.unwrap_or(settings.samples);
+        settings.max_depth = args.max_depth.unwrap_or(settings.max_depth);
+        settings.use_octree = true;
+        eprintln!("sweep {}", path.display());
+        for &cost_driven in &[true, false] {
+            for &max_depth in &args.sweep_depths {
+                for &leaf_size in &args.sweep_leaf_sizes {
+                    let params = glint::accel::OctreeParams {
+                        max_depth: max_depth.min(glint::accel::MAX_OCTREE_DEPTH),
+                        leaf_size: leaf_size.max(1),
+                        cost_driven,
+                    };
+                    let (mut builds, mut renders) = (Vec::new(), Vec::new());
+                    let mut tree = None;
+                    for _ in 0..args.repeat {
+                        let (t, s) =
+                            timed(|| pool.install(|| Octree::build(&scene.shapes, params)));
+                        builds.push(s);
+                        tree = Some(t);
+                    }
+                    let Some(octree) = tree else {
+                        bail!("no repeats")
+                    };
+                    let renderer = Renderer::new(&scene, &octree, settings)?;
+                    let counts = pool.install(|| renderer.render(true, None).1);
+                    for _ in 0..args.repeat {
+                        renders.push(timed(|| pool.install(|| renderer.render(false, None))).1);
+                    }
+                    let render_s = median(renders);
+                    let total = counts.rays.total().max(1) as f64;
+                    let row = SweepRow {
+                        scene: path.display().to_string(),
+                        octree_params: params,
+                        build_s: median(builds),
+                        render_s,
+                        mrays_per_s: total / render_s.max(1e-12) / 1e6,
+                        intersection_tests_per_ray: counts.work.intersection_tests as f64 / total,
+                        traversal_steps_per_ray: counts.work.traversal_steps as f64 / total,
+                        leaves_visited_per_ray: counts.work.leaves_visited as f64 / total,
+                        octree_stats: octree.stats(),
+                    };
+                    if args.format == Format::Markdown {
+                        print_sweep_row(&row);
+                    }
+                    rows.push(row);
+                }
+            }
+        }
+    }
+    if args.format == Format::Json {
+        println!("{}", serde_json::to_string_pretty(&rows)?);
+    }
+    Ok(())
+}
+
+fn print_sweep_row(r: &SweepRow) {
+    let name = std::path::Path::new(&r.scene)
+        .file_name()
+        .map_or(r.scene.clone(), |n| n.to_string_lossy().into_owned());
+    println!(
+        "| {} | {} | {} | {} | {:.3} | {:.3} | {:.2} | {:.2} | {:.2} | {} | {:.0} |",
+        name,
+        if r.octree_params.cost_driven {
+            "on"
+        } else {
+            "off"
+        },
+        r.octree_params.max_depth,
+        r.octree_params.leaf_size,
+        r.build_s,
+        r.render_s,
+        r.intersection_tests_per_ray,
+        r.traversal_steps_per_ray,
+        r.leaves_visited_per_ray,
+        r.octree_stats.nodes,
+        r.octree_stats.memory_bytes as f64 / 1024.0
+    );
 }

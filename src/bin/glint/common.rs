@@ -48,3 +48,31 @@ pub fn parse_positive(s: &str) -> std::result::Result<u32, String> {
         _ => Err(format!("expected a whole number of at least 1, got `{s}`")),
     }
 }
+
+/// Octree parameters on the command line; unset ones keep the scene's.
+#[derive(clap::Args, Clone, Copy, Debug, Default)]
+pub struct OctreeArgs {
+    /// Deepest octree level (root = 0).
+    #[arg(long)]
+    pub octree_max_depth: Option<u32>,
+    /// References up to which a node stays a leaf.
+    #[arg(long, value_parser = parse_positive)]
+    pub octree_leaf_size: Option<u32>,
+    /// Let the surface-area cost estimate stop subdivision early.
+    #[arg(long, value_enum)]
+    pub octree_cost_driven: Option<Switch>,
+}
+
+impl OctreeArgs {
+    pub fn apply(&self, params: &mut glint::accel::OctreeParams) {
+        if let Some(d) = self.octree_max_depth {
+            params.max_depth = d.min(glint::accel::MAX_OCTREE_DEPTH);
+        }
+        if let Some(n) = self.octree_leaf_size {
+            params.leaf_size = n;
+        }
+        if let Some(c) = self.octree_cost_driven {
+            params.cost_driven = c.is_on();
+        }
+    }
+}

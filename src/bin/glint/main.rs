@@ -4,6 +4,8 @@
 mod bench;
 mod common;
 mod render_cmd;
+#[cfg(feature = "gui")]
+mod view;
 
 use clap::{Parser, Subcommand};
 
@@ -24,6 +26,9 @@ enum Command {
     Render(render_cmd::RenderArgs),
     /// Time scenes with the octree on and off, interleaved, and report medians.
     Bench(bench::BenchArgs),
+    /// Open a scene in the interactive viewer (the default command).
+    #[cfg(feature = "gui")]
+    View(view::ViewArgs),
 }
 
 fn main() -> std::process::ExitCode {
@@ -31,6 +36,11 @@ fn main() -> std::process::ExitCode {
     let result = match cli.command {
         Some(Command::Render(args)) => render_cmd::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
+        #[cfg(feature = "gui")]
+        Some(Command::View(args)) => view::run(&args),
+        #[cfg(feature = "gui")]
+        None => view::run(&view::ViewArgs::default()),
+        #[cfg(not(feature = "gui"))]
         None => {
             use clap::CommandFactory;
             eprintln!(

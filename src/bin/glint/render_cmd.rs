@@ -10,7 +10,7 @@ use glint::render::{RenderSettings, Renderer, ViewMode};
 use glint::stats::RayCounts;
 use serde::Serialize;
 
-use crate::common::{Switch, load_scene, parse_positive, parse_samples, thread_pool};
+use crate::common::{OctreeArgs, Switch, load_scene, parse_positive, parse_samples, thread_pool};
 
 #[derive(clap::Args)]
 pub struct RenderArgs {
@@ -34,6 +34,8 @@ pub struct RenderArgs {
     /// Use the octree (default: the scene's setting, on unless it says otherwise).
     #[arg(long, value_enum)]
     pub octree: Option<Switch>,
+    #[command(flatten)]
+    pub octree_params: OctreeArgs,
     /// Render threads (default: one per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
@@ -56,6 +58,7 @@ struct RenderStats {
     max_depth: u32,
     threads: usize,
     octree: bool,
+    octree_params: glint::accel::OctreeParams,
     view: ViewMode,
     load_s: f64,
     build_s: f64,
@@ -79,7 +82,8 @@ struct RaysJson {
 }
 
 pub fn run(args: &RenderArgs) -> Result<()> {
-    let (scene, load_s) = load_scene(&args.scene)?;
+    let (mut scene, load_s) = load_scene(&args.scene)?;
+    args.octree_params.apply(&mut scene.octree_params);
     let mut settings = RenderSettings::from_scene(&scene);
     settings.width = args.width.unwrap_or(settings.width);
     settings.height = args.height.unwrap_or(settings.height);
@@ -150,6 +154,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             max_depth: settings.max_depth,
             threads,
             octree: settings.use_octree,
+            octree_params: scene.octree_params,
             view: settings.view,
             load_s,
             build_s,

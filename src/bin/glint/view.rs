@@ -1,0 +1,91 @@
+//! `glint view` (and `glint` with no arguments): the interactive viewer.
+
+use std::path::PathBuf;
+
+use anyhow::{Result, anyhow};
+use glint::render::ViewMode;
+use glint::viewer::{GlintApp, SceneSource, ViewerOptions};
+
+use crate::common::Switch;
+
+#[derive(clap::Args)]
+pub struct ViewArgs {
+    /// Scene file (.toml or .nff); the built-in default scene if omitted.
+    pub scene: Option<PathBuf>,
+    /// Save a screenshot of the whole window once the final pass is on
+    /// screen, then exit.
+    #[arg(long)]
+    pub screenshot: Option<PathBuf>,
+    /// Frames to wait after the final pass before the screenshot.
+    #[arg(long, default_value_t = 3)]
+    pub frames: u32,
+    /// Initial view mode.
+    #[arg(long, value_parser = |s: &str| s.parse::<ViewMode>())]
+    pub view: Option<ViewMode>,
+    /// Start with the octree on or off (default: the scene's setting).
+    #[arg(long, value_enum)]
+    pub octree: Option<Switch>,
+    /// Start with anti-aliasing on or off (default: on if the scene asks for 16 samples).
+    #[arg(long, value_enum)]
+    pub aa: Option<Switch>,
+    /// Render threads (default: one per core).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    /// Window size as WIDTHxHEIGHT in points.
+    #[arg(long, default_value = "1400x860")]
+    pub window: String,
+}
+
+impl Default for ViewArgs {
+    /// The same as `glint view` with no flags.
+    fn default() -> Self {
+        Self {
+            scene: None,
+            screenshot: None,
+            frames: 3,
+            view: None,
+            octree: None,
+            aa: None,
+            threads: 0,
+            window: "1400x860".into(),
+        }
+    }
+}
+
+pub fn run(args: &ViewArgs) -> Result<()> {
+    let source = match &args.scene {
+        Some(p) => SceneSource::File(p.clone()),
+        None => SceneSource::BuiltIn,
+    };
+    // Load once up front so a bad scene is a clear error, not a blank window.
+    source.load()?;
+    let (w, h) = args
+        .window
+        .split_once('x')
+        .and_then(|(w, h)| Some((w.parse::<f32>().ok()?, h.parse::<f32>().ok()?)))
+        .ok_or_else(|| anyhow!("--window expects WIDTHxHEIGHT, got `{}`", args.window))?;
+    let options = ViewerOptions {
+        screenshot: args.screenshot.clone(),
+        frames: args.frames,
+        threads: args.threads,
+        view: args.view,
+        octree: args.octree.map(Switch::is_on),
+        anti_aliasing: args.aa.map(Switch::is_on),
+    };
+    let native = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_inner_size([w, h])
+            .with_title("glint"),
+        ..Default::default()
+    };
+    eframe::run_native(
+        "glint",
+        native,
+        Box::new(move |cc| {
+            let ctx = cc.egui_ctx.clone();
+            let app = GlintApp::new(source, options, move || ctx.request_repaint())?;
+            Ok(Box::new(app))
+        }),
+    )
+    .map_err(|e| anyhow!("the viewer window failed: {e}"))
+}

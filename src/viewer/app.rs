@@ -1,0 +1,563 @@
+//! The viewer's application state and frame logic.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+use egui::{
+    Color32, Key, KeyboardShortcut, Modifiers, PointerButton, Sense, TextureHandle, TextureOptions,
+};
+
+use super::orbit;
+use super::worker::{Job, PassKind, PassRecord, Worker};
+use crate::accel::Octree;
+use crate::camera::CameraSpec;
+use crate::render::{RenderSettings, ViewMode};
+use crate::scene::Scene;
+
+/// Where the current scene came from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SceneSource {
+    BuiltIn,
+    File(PathBuf),
+}
+
+impl SceneSource {
+    pub fn load(&self) -> anyhow::Result<Scene> {
+        Ok(match self {
+            SceneSource::BuiltIn => super::builtin::default_scene()?,
+            SceneSource::File(p) => crate::scene::load(p)?,
+        })
+    }
+
+    /// A short name for file names: the scene file's stem.
+    pub fn stem(&self) -> String {
+        match self {
+            SceneSource::BuiltIn => "default".into(),
+            SceneSource::File(p) => p
+                .file_stem()
+                .map_or("scene".into(), |s| s.to_string_lossy().into_owned()),
+        }
+    }
+}
+
+/// Start-up options of the viewer.
+#[derive(Clone, Debug, Default)]
+pub struct ViewerOptions {
+    /// Save a screenshot of the whole window here once the final pass is on
+    /// screen, then exit.
+    pub screenshot: Option<PathBuf>,
+    /// Frames to wait after the final pass before the screenshot.
+    pub frames: u32,
+    /// Render threads (0 = one per core).
+    pub threads: usize,
+    /// Initial settings that differ from the scene's (view mode, octree, AA).
+    pub view: Option<ViewMode>,
+    pub octree: Option<bool>,
+    pub anti_aliasing: Option<bool>,
+}
+
+/// A message shown in the status area.
+#[derive(Clone, Debug)]
+pub struct Message {
+    pub text: String,
+    pub is_error: bool,
+}
+
+/// Everything that decides the rendered image; a change restarts the passes.
+#[derive(Clone, Debug, PartialEq)]
+struct RenderInputs {
+    camera: CameraSpec,
+    settings: RenderSettings,
+    anti_aliasing: bool,
+    scene_version: u64,
+    preview_divisor: u32,
+}
+
+/// What the panels ask for; applied once per frame after the UI is drawn.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Command {
+    Open,
+    Reload,
+    Export,
+    ResetCamera,
+}
+
+pub struct GlintApp {
+    // What the user edits.
+    pub(crate) source: SceneSource,
+    pub(crate) scene: Arc<Scene>,
+    /// Bumped whenever lights or materials are edited.
+    pub(crate) scene_version: u64,
+    pub(crate) camera: CameraSpec,
+    pub(crate) settings: RenderSettings,
+    pub(crate) anti_aliasing: bool,
+    // Runtime.
+    pub(crate) octree: Arc<Octree>,
+    pub(crate) build_seconds: f64,
+    pub(crate) worker: Worker,
+    texture: Option<TextureHandle>,
+    shown_version: u64,
+    submitted: Option<RenderInputs>,
+    pub(crate) dragging: bool,
+    pub(crate) messages: Vec<Message>,
+    pub(crate) commands: Vec<Command>,
+    options: ViewerOptions,
+    frames_since_final: u32,
+    screenshot_requested: bool,
+    /// Set when the app wants the window closed (after `--screenshot`).
+    pub exit_requested: bool,
+    started: Instant,
+}
+
+impl GlintApp {
+    /// Loads `source` and starts rendering; `repaint` wakes the UI thread.
+    pub fn new(
+        source: SceneSource,
+        options: ViewerOptions,
+        repaint: impl Fn() + Send + Sync + 'static,
+    ) -> anyhow::Result<Self> {
+        let scene = source.load()?;
+        let worker = Worker::spawn(options.threads, repaint);
+        let mut settings = RenderSettings::from_scene(&scene);
+        let anti_aliasing = options.anti_aliasing.unwrap_or(scene.image.samples == 16);
+        if let Some(v) = options.view {
+            settings.view = v;
+        }
+        if let Some(o) = options.octree {
+            settings.use_octree = o;
+        }
+        let (octree, build_seconds) = build_octree(&scene);
+        Ok(Self {
+            camera: scene.camera,
+            source,
+            scene: Arc::new(scene),
+            scene_version: 0,
+            settings,
+            anti_aliasing,
+            octree: Arc::new(octree),
+            build_seconds,
+            worker,
+            texture: None,
+            shown_version: 0,
+            submitted: None,
+            dragging: false,
+            messages: Vec::new(),
+            commands: Vec::new(),
+            options,
+            frames_since_final: 0,
+            screenshot_requested: false,
+            exit_requested: false,
+            started: Instant::now(),
+        })
+    }
+
+    pub fn settings(&self) -> &RenderSettings {
+        &self.settings
+    }
+
+    /// Render settings as the panels edit them; a change restarts the passes.
+    pub fn settings_mut(&mut self) -> &mut RenderSettings {
+        &mut self.settings
+    }
+
+    pub fn anti_aliasing(&self) -> bool {
+        self.anti_aliasing
+    }
+
+    pub fn worker(&self) -> &Worker {
+        &self.worker
+    }
+
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    pub fn camera(&self) -> &CameraSpec {
+        &self.camera
+    }
+
+    pub fn messages(&self) -> &[Message] {
+        &self.messages
+    }
+
+    /// Mutable access to lights and materials; marks the image stale.
+    pub fn scene_mut(&mut self) -> &mut Scene {
+        self.scene_version += 1;
+        Arc::make_mut(&mut self.scene)
+    }
+
+    pub(crate) fn say(&mut self, text: impl Into<String>, is_error: bool) {
+        let text = text.into();
+        if is_error {
+            eprintln!("glint: {text}");
+        }
+        self.messages.push(Message { text, is_error });
+        if self.messages.len() > 50 {
+            self.messages.remove(0);
+        }
+    }
+
+    /// Preview divisor while dragging: the smallest of 1, 2, 4, 8 whose
+    /// estimated 1-sample pass time (last full 1-sample pass / divisor^2)
+    /// stays under 40 ms, so the image follows the mouse.
+    fn preview_divisor(&self, history: &[PassRecord]) -> u32 {
+        if !self.dragging {
+            return 1;
+        }
+        let Some(last) = history.iter().rev().find(|r| r.kind == PassKind::OneSample) else {
+            return 4;
+        };
+        let pixels_now = self.settings.width as f64 * self.settings.height as f64;
+        let per_pixel = last.seconds / (last.width as f64 * last.height as f64).max(1.0);
+        [1u32, 2, 4, 8]
+            .into_iter()
+            .find(|d| per_pixel * pixels_now / (*d as f64 * *d as f64) <= 0.040)
+            .unwrap_or(8)
+    }
+
+    /// Submits a new job if anything that decides the image changed.
+    pub fn sync_render(&mut self) {
+        let history = self.worker.history();
+        let inputs = RenderInputs {
+            camera: self.camera,
+            settings: self.settings,
+            anti_aliasing: self.anti_aliasing,
+            scene_version: self.scene_version,
+            preview_divisor: self.preview_divisor(&history),
+        };
+        if self.submitted.as_ref() == Some(&inputs) {
+            return;
+        }
+        self.worker.submit(Job {
+            scene: Arc::clone(&self.scene),
+            octree: Arc::clone(&self.octree),
+            camera: self.camera,
+            settings: self.settings,
+            anti_aliasing: self.anti_aliasing,
+            preview_divisor: inputs.preview_divisor,
+        });
+        self.submitted = Some(inputs);
+    }
+
+    /// Uploads the display buffer to the texture if new tiles arrived.
+    fn update_texture(&mut self, ctx: &egui::Context) {
+        let shown = self.shown_version;
+        let update = self.worker.try_with_buffer(|b| {
+            (b.version != shown && b.width > 0).then(|| {
+                (
+                    b.version,
+                    egui::ColorImage::from_rgba_unmultiplied(
+                        [b.width as usize, b.height as usize],
+                        &b.rgba,
+                    ),
+                )
+            })
+        });
+        if let Some(Some((version, image))) = update {
+            self.shown_version = version;
+            match &mut self.texture {
+                Some(t) => t.set(image, TextureOptions::NEAREST),
+                None => {
+                    self.texture =
+                        Some(ctx.load_texture("glint-render", image, TextureOptions::NEAREST))
+                }
+            }
+        }
+    }
+
+    /// Is the final pass of the current job on screen?
+    pub fn final_pass_shown(&self) -> bool {
+        let generation = self.worker.generation();
+        let shown = self.shown_version;
+        self.worker
+            .try_with_buffer(|b| b.generation == generation && b.finished && b.version == shown)
+            .unwrap_or(false)
+    }
+
+    fn apply_commands(&mut self, ctx: &egui::Context) {
+        for command in std::mem::take(&mut self.commands) {
+            match command {
+                Command::ResetCamera => self.camera = self.scene.camera,
+                Command::Reload => self.reload(),
+                Command::Open => self.open_dialog(),
+                Command::Export => self.export(),
+            }
+        }
+        let _ = ctx;
+    }
+
+    /// Re-reads the scene file, keeping the camera; a failure keeps the
+    /// current scene on screen.
+    pub fn reload(&mut self) {
+        match self.source.load() {
+            Ok(scene) => {
+                self.install_scene(scene, false);
+                self.say(format!("reloaded {}", self.scene.name), false);
+            }
+            Err(e) => self.say(
+                format!("reload failed, keeping the previous scene: {e:#}"),
+                true,
+            ),
+        }
+    }
+
+    /// Opens another scene file.
+    pub fn open(&mut self, path: PathBuf) {
+        let source = SceneSource::File(path);
+        match source.load() {
+            Ok(scene) => {
+                self.source = source;
+                self.install_scene(scene, true);
+                self.say(format!("opened {}", self.scene.name), false);
+            }
+            Err(e) => self.say(format!("cannot open: {e:#}"), true),
+        }
+    }
+
+    fn install_scene(&mut self, scene: Scene, take_camera: bool) {
+        let (octree, seconds) = build_octree(&scene);
+        if take_camera {
+            self.camera = scene.camera;
+            let keep_view = self.settings.view;
+            self.settings = RenderSettings {
+                view: keep_view,
+                use_octree: self.settings.use_octree,
+                ..RenderSettings::from_scene(&scene)
+            };
+        }
+        self.octree = Arc::new(octree);
+        self.build_seconds = seconds;
+        self.scene = Arc::new(scene);
+        self.scene_version += 1;
+    }
+
+    fn open_dialog(&mut self) {
+        if !file_dialog_available() {
+            self.say("no file dialog is available here (no desktop portal); pass the scene on the command line: glint view SCENE", true);
+            return;
+        }
+        if let Some(path) = rfd::FileDialog::new()
+            .add_filter("scenes", &["toml", "nff"])
+            .pick_file()
+        {
+            self.open(path);
+        }
+    }
+
+    /// Writes the displayed frame to a PNG chosen in a save dialog, or, where
+    /// no dialog is available, to the current directory.
+    pub fn export(&mut self) {
+        let default_name = format!("{}-{}.png", self.source.stem(), timestamp());
+        let path = if file_dialog_available() {
+            match rfd::FileDialog::new()
+                .set_file_name(&default_name)
+                .add_filter("PNG", &["png"])
+                .save_file()
+            {
+                Some(p) => p,
+                None => return,
+            }
+        } else {
+            let p = PathBuf::from(&default_name);
+            self.say(
+                format!(
+                    "no file dialog available; exporting to the current directory as {default_name}"
+                ),
+                false,
+            );
+            p
+        };
+        match self.export_to(&path) {
+            Ok(()) => self.say(format!("exported {}", path.display()), false),
+            Err(e) => self.say(format!("export to {} failed: {e:#}", path.display()), true),
+        }
+    }
+
+    /// Saves the display buffer exactly as shown, through a temporary file.
+    pub fn export_to(&self, path: &Path) -> anyhow::Result<()> {
+        let (w, h, rgba) = self
+            .worker
+            .with_buffer(|b| (b.width, b.height, b.rgba.clone()));
+        anyhow::ensure!(w > 0 && h > 0, "nothing has been rendered yet");
+        let rgb: Vec<u8> = rgba
+            .chunks_exact(4)
+            .flat_map(|p| [p[0], p[1], p[2]])
+            .collect();
+        let image = image::RgbImage::from_raw(w, h, rgb)
+            .ok_or_else(|| anyhow::anyhow!("buffer size mismatch"))?;
+        let file_name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let tmp = path.with_file_name(format!(".{file_name}.{}.tmp", std::process::id()));
+        image.save_with_format(&tmp, image::ImageFormat::Png)?;
+        if let Err(e) = std::fs::rename(&tmp, path) {
+            let _ = std::fs::remove_file(&tmp);
+            return Err(e.into());
+        }
+        Ok(())
+    }
+
+    /// Keyboard shortcuts; R only when no text field has the focus.
+    fn shortcuts(&mut self, ctx: &egui::Context) {
+        let open = KeyboardShortcut::new(Modifiers::COMMAND, Key::O);
+        let save = KeyboardShortcut::new(Modifiers::COMMAND, Key::S);
+        let reload = KeyboardShortcut::new(Modifiers::NONE, Key::F5);
+        ctx.input_mut(|i| {
+            if i.consume_shortcut(&open) {
+                self.commands.push(Command::Open);
+            }
+            if i.consume_shortcut(&save) {
+                self.commands.push(Command::Export);
+            }
+            if i.consume_shortcut(&reload) {
+                self.commands.push(Command::Reload);
+            }
+        });
+        if !ctx.egui_wants_keyboard_input()
+            && ctx.input(|i| i.key_pressed(Key::R) && i.modifiers.is_none())
+        {
+            self.commands.push(Command::ResetCamera);
+        }
+    }
+
+    /// The image, and mouse control of the camera over it.
+    pub(crate) fn image_ui(&mut self, ui: &mut egui::Ui) {
+        let available = ui.available_size();
+        let aspect = self.settings.width as f32 / self.settings.height.max(1) as f32;
+        // Fit the image into the panel (display-only: never restarts a render).
+        let mut size = egui::vec2(available.x, available.x / aspect);
+        if size.y > available.y {
+            size = egui::vec2(available.y * aspect, available.y);
+        }
+        let (rect, response) = ui.allocate_exact_size(available, Sense::click_and_drag());
+        let image_rect = egui::Rect::from_center_size(rect.center(), size);
+        match &self.texture {
+            Some(t) => {
+                let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
+                ui.painter().image(t.id(), image_rect, uv, Color32::WHITE);
+            }
+            None => {
+                ui.painter().text(
+                    rect.center(),
+                    egui::Align2::CENTER_CENTER,
+                    "rendering…",
+                    egui::FontId::proportional(16.0),
+                    ui.visuals().text_color(),
+                );
+            }
+        }
+        // Mouse: left orbits, right or middle pans, the wheel dollies.
+        let delta = response.drag_delta();
+        let scale = 1.0 / size.y.max(1.0) as f64;
+        let mut moved = false;
+        if response.dragged_by(PointerButton::Primary) && delta != egui::Vec2::ZERO {
+            self.camera = orbit::orbit(
+                &self.camera,
+                -delta.x as f64 * scale * 3.0,
+                delta.y as f64 * scale * 3.0,
+            );
+            moved = true;
+        }
+        if (response.dragged_by(PointerButton::Secondary)
+            || response.dragged_by(PointerButton::Middle))
+            && delta != egui::Vec2::ZERO
+        {
+            self.camera = orbit::pan(&self.camera, delta.x as f64, delta.y as f64, size.y as f64);
+            moved = true;
+        }
+        if response.hovered() {
+            let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+            if scroll != 0.0 {
+                self.camera = orbit::dolly(&self.camera, scroll as f64 * 0.002);
+            }
+        }
+        self.dragging = response.is_pointer_button_down_on() && (moved || self.dragging);
+        if !response.is_pointer_button_down_on() {
+            self.dragging = false;
+        }
+    }
+
+    /// One frame of the viewer: drawn into `ui`, which covers the window.
+    pub fn frame_ui(&mut self, ui: &mut egui::Ui) {
+        let ctx = ui.ctx().clone();
+        self.update_texture(&ctx);
+        self.shortcuts(&ctx);
+        egui::Panel::top("menu").show(ui, |ui| super::panels::menu_ui(self, ui));
+        egui::Panel::bottom("status").show(ui, |ui| super::panels::status_ui(self, ui));
+        egui::Panel::left("controls")
+            .resizable(true)
+            .default_size(300.0)
+            .show(ui, |ui| super::panels::controls_ui(self, ui));
+        egui::Panel::right("timing")
+            .resizable(true)
+            .default_size(300.0)
+            .show(ui, |ui| super::panels::timing_ui(self, ui));
+        egui::CentralPanel::default_margins().show(ui, |ui| self.image_ui(ui));
+        self.apply_commands(&ctx);
+        self.sync_render();
+        self.screenshot_logic(&ctx);
+    }
+
+    fn screenshot_logic(&mut self, ctx: &egui::Context) {
+        let Some(path) = self.options.screenshot.clone() else {
+            return;
+        };
+        if self.screenshot_requested {
+            // Keep frames coming until the screenshot callback has run.
+            ctx.request_repaint();
+            return;
+        }
+        if self.final_pass_shown() {
+            self.frames_since_final += 1;
+            if self.frames_since_final >= self.options.frames.max(1) {
+                self.screenshot_requested = true;
+                let ctx2 = ctx.clone();
+                ctx.request_screenshot(move |image: Arc<egui::ColorImage>| {
+                    let [w, h] = image.size;
+                    let rgba: Vec<u8> = image.pixels.iter().flat_map(|c| c.to_array()).collect();
+                    let result = image::RgbaImage::from_raw(w as u32, h as u32, rgba)
+                        .ok_or_else(|| anyhow::anyhow!("bad screenshot size"))
+                        .and_then(|img| img.save(&path).map_err(anyhow::Error::from));
+                    match result {
+                        Ok(()) => eprintln!("glint: saved window screenshot {}", path.display()),
+                        Err(e) => eprintln!("glint: screenshot failed: {e:#}"),
+                    }
+                    ctx2.send_viewport_cmd(egui::ViewportCommand::Close);
+                });
+            }
+            ctx.request_repaint();
+        }
+    }
+
+    pub(crate) fn uptime(&self) -> f64 {
+        self.started.elapsed().as_secs_f64()
+    }
+}
+
+impl eframe::App for GlintApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        self.frame_ui(ui);
+    }
+}
+
+fn build_octree(scene: &Scene) -> (Octree, f64) {
+    let start = Instant::now();
+    let octree = Octree::build(&scene.shapes, scene.octree_params);
+    (octree, start.elapsed().as_secs_f64())
+}
+
+/// rfd's dialogs go through the XDG desktop portal on D-Bus; without a
+/// session bus (a bare X server such as Xvfb) there is no dialog to show.
+fn file_dialog_available() -> bool {
+    std::env::var_os("DBUS_SESSION_BUS_ADDRESS").is_some_and(|v| !v.is_empty())
+}
+
+/// Local-time-free timestamp for file names: seconds since the Unix epoch.
+fn timestamp() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    format!("{secs}")
+}

@@ -1,0 +1,324 @@
+//! The viewer's panels. Each `*_ui` function draws one panel and edits the
+//! app's state; actions that do I/O are queued as commands.
+
+use egui::{Color32, DragValue, RichText};
+use egui_plot::{Legend, Line, Plot, Points};
+
+use super::app::{Command, GlintApp};
+use super::worker::PassKind;
+use crate::math::DVec3;
+use crate::render::ViewMode;
+
+pub fn menu_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
+    egui::MenuBar::new().ui(ui, |ui| {
+        ui.menu_button("File", |ui| {
+            if ui.button("Open scene…  (Ctrl+O)").clicked() {
+                app.commands.push(Command::Open);
+                ui.close();
+            }
+            if ui.button("Reload  (F5)").clicked() {
+                app.commands.push(Command::Reload);
+                ui.close();
+            }
+            if ui.button("Export PNG…  (Ctrl+S)").clicked() {
+                app.commands.push(Command::Export);
+                ui.close();
+            }
+            ui.separator();
+            if ui.button("Quit").clicked() {
+                ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);
+            }
+        });
+        ui.menu_button("View", |ui| {
+            if ui.button("Reset camera  (R)").clicked() {
+                app.commands.push(Command::ResetCamera);
+                ui.close();
+            }
+        });
+        ui.separator();
+        ui.label(RichText::new(&app.scene.name).weak());
+    });
+}
+
+fn vec3_ui(ui: &mut egui::Ui, label: &str, v: &mut DVec3, speed: f64) -> bool {
+    let mut changed = false;
+    ui.horizontal(|ui| {
+        ui.label(label);
+        for c in [&mut v.x, &mut v.y, &mut v.z] {
+            changed |= ui
+                .add(DragValue::new(c).speed(speed).max_decimals(4))
+                .changed();
+        }
+    });
+    changed
+}
+
+fn color_ui(ui: &mut egui::Ui, label: &str, c: &mut DVec3) -> bool {
+    // egui's picker edits linear RGB, as glint's colours are.
+    let mut rgb = [c.x as f32, c.y as f32, c.z as f32];
+    let mut changed = false;
+    ui.horizontal(|ui| {
+        ui.label(label);
+        if ui.color_edit_button_rgb(&mut rgb).changed() {
+            changed = true;
+        }
+    });
+    if changed {
+        *c = DVec3::new(rgb[0] as f64, rgb[1] as f64, rgb[2] as f64);
+    }
+    changed
+}
+
+pub fn controls_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
+    egui::ScrollArea::vertical().show(ui, |ui| {
+        let extent = app.scene.extent_bounds().extent().max_element().max(1e-9);
+        let speed = extent * 0.002;
+
+        egui::CollapsingHeader::new("Render settings")
+            .default_open(true)
+            .show(ui, |ui| {
+                ui.checkbox(
+                    &mut app.anti_aliasing,
+                    "Anti-aliasing (16 samples, 4x4 grid)",
+                );
+                ui.checkbox(&mut app.settings.use_octree, "Octree");
+                ui.horizontal(|ui| {
+                    ui.label("Max depth");
+                    ui.add(DragValue::new(&mut app.settings.max_depth).range(1..=64));
+                });
+                ui.horizontal(|ui| {
+                    ui.label("Image size");
+                    ui.add(DragValue::new(&mut app.settings.width).range(1..=8192));
+                    ui.label("x");
+                    ui.add(DragValue::new(&mut app.settings.height).range(1..=8192));
+                });
+                ui.horizontal(|ui| {
+                    ui.label("View");
+                    for v in ViewMode::ALL {
+                        ui.selectable_value(&mut app.settings.view, v, v.name());
+                    }
+                });
+            });
+
+        egui::CollapsingHeader::new("Camera")
+            .default_open(true)
+            .show(ui, |ui| {
+                let mut c = app.camera;
+                vec3_ui(ui, "eye", &mut c.eye, speed);
+                vec3_ui(ui, "lookat", &mut c.lookat, speed);
+                vec3_ui(ui, "up", &mut c.up, 0.01);
+                ui.horizontal(|ui| {
+                    ui.label("fov");
+                    ui.add(
+                        DragValue::new(&mut c.fov)
+                            .range(0.01..=179.0)
+                            .speed(0.1)
+                            .suffix("°"),
+                    );
+                });
+                // Apply only cameras the renderer accepts (up not parallel to the view).
+                if c != app.camera && crate::camera::Camera::new(&c, 2, 2).is_ok() {
+                    app.camera = c;
+                }
+                if ui.button("Reset camera (R)").clicked() {
+                    app.commands.push(Command::ResetCamera);
+                }
+            });
+
+        egui::CollapsingHeader::new("Lights")
+            .default_open(true)
+            .show(ui, |ui| {
+                for i in 0..app.scene.lights.len() {
+                    let mut light = app.scene.lights[i].clone();
+                    ui.label(format!("Light {}", i + 1));
+                    let mut changed = vec3_ui(ui, "position", &mut light.position, speed);
+                    changed |= color_ui(ui, "colour", &mut light.color);
+                    if changed {
+                        app.scene_mut().lights[i] = light;
+                    }
+                    ui.separator();
+                }
+            });
+
+        ui.collapsing("Materials", |ui| {
+            for i in 0..app.scene.materials.len() {
+                let mut m = app.scene.materials[i].clone();
+                let mut changed = false;
+                egui::CollapsingHeader::new(&m.name)
+                    .id_salt(("material", i))
+                    .show(ui, |ui| {
+                        changed |= color_ui(ui, "colour", &mut m.color);
+                        egui::Grid::new(("material-grid", i))
+                            .num_columns(2)
+                            .show(ui, |ui| {
+                                for (label, value, max) in [
+                                    ("kd", &mut m.kd, 1.0),
+                                    ("ks", &mut m.ks, 1.0),
+                                    ("shininess", &mut m.shininess, 10_000.0),
+                                    ("reflectivity", &mut m.reflectivity, 1.0),
+                                    ("transparency", &mut m.transparency, 1.0),
+                                    ("ior", &mut m.ior, 4.0),
+                                ] {
+                                    ui.label(label);
+                                    let step = if max > 10.0 { 1.0 } else { 0.005 };
+                                    changed |= ui
+                                        .add(DragValue::new(value).range(0.0..=max).speed(step))
+                                        .changed();
+                                    ui.end_row();
+                                }
+                            });
+                    });
+                if changed {
+                    m.ior = m.ior.max(0.01);
+                    app.scene_mut().materials[i] = m;
+                }
+            }
+        });
+    });
+}
+
+pub fn timing_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
+    let history = app.worker().history();
+    ui.heading("Timing");
+    let last = |kind: PassKind| history.iter().rev().find(|r| r.kind == kind);
+    egui::Grid::new("timing-grid")
+        .num_columns(2)
+        .striped(true)
+        .show(ui, |ui| {
+            let mut row = |label: &str, value: String| {
+                ui.label(label);
+                ui.label(value);
+                ui.end_row();
+            };
+            match last(PassKind::OneSample) {
+                Some(r) => row("1-sample pass", format!("{:.3} s", r.seconds)),
+                None => row("1-sample pass", "–".into()),
+            }
+            match last(PassKind::SixteenSamples) {
+                Some(r) => row("16-sample pass", format!("{:.3} s", r.seconds)),
+                None => row("16-sample pass", "–".into()),
+            }
+            if let (Some(a), Some(b)) = (last(PassKind::OneSample), last(PassKind::SixteenSamples))
+            {
+                row(
+                    "16 / 1 time ratio",
+                    format!("{:.1}x", b.seconds / a.seconds.max(1e-9)),
+                );
+            }
+            if let Some(r) = history.last() {
+                row(
+                    "Mrays/s (last pass)",
+                    format!("{:.2}", r.rays.total() as f64 / r.seconds.max(1e-9) / 1e6),
+                );
+                row("rays: primary", format!("{}", r.rays.primary));
+                row("rays: shadow", format!("{}", r.rays.shadow));
+                row("rays: reflection", format!("{}", r.rays.reflection));
+                row("rays: refraction", format!("{}", r.rays.refraction));
+            }
+            let stats = app.octree.stats();
+            row("octree build", format!("{:.3} s", app.build_seconds));
+            row(
+                "octree nodes",
+                format!("{} ({} leaves)", stats.nodes, stats.leaves),
+            );
+            row(
+                "octree memory",
+                format!("{:.1} KiB", stats.memory_bytes as f64 / 1024.0),
+            );
+            row("shapes", format!("{}", app.scene.shapes.len()));
+        });
+    ui.separator();
+    ui.label("Pass times this session (s)");
+    // One series per combination of the toggles, so each toggle's effect
+    // shows as a jump between series.
+    let series = [
+        (
+            true,
+            false,
+            "octree on, 1 spp",
+            Color32::from_rgb(80, 160, 255),
+        ),
+        (
+            false,
+            false,
+            "octree off, 1 spp",
+            Color32::from_rgb(255, 120, 80),
+        ),
+        (
+            true,
+            true,
+            "octree on, 16 spp",
+            Color32::from_rgb(60, 200, 120),
+        ),
+        (
+            false,
+            true,
+            "octree off, 16 spp",
+            Color32::from_rgb(230, 190, 60),
+        ),
+    ];
+    Plot::new("pass-times")
+        .height(180.0)
+        .legend(Legend::default())
+        .allow_drag(false)
+        .allow_zoom(false)
+        .allow_scroll(false)
+        .x_axis_label("session time (s)")
+        .show(ui, |plot| {
+            for (octree, sixteen, name, color) in series {
+                let points: Vec<[f64; 2]> = history
+                    .iter()
+                    .filter(|r| {
+                        r.octree == octree
+                            && (r.kind == PassKind::SixteenSamples) == sixteen
+                            && !matches!(r.kind, PassKind::Preview { .. })
+                    })
+                    .map(|r| [r.finished_at, r.seconds])
+                    .collect();
+                if !points.is_empty() {
+                    plot.line(Line::new(name, points.clone()).color(color));
+                    plot.points(Points::new(name, points).color(color).radius(3.0));
+                }
+            }
+        });
+}
+
+pub fn status_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
+    ui.horizontal(|ui| {
+        let status = app
+            .worker()
+            .try_with_buffer(|b| (b.pass, b.tiles_done, b.tiles_total, b.finished));
+        match status {
+            Some((Some(pass), done, total, finished)) => {
+                if finished {
+                    ui.label(format!(
+                        "done: {} ({}x{})",
+                        pass.label(),
+                        app.settings().width,
+                        app.settings().height
+                    ));
+                } else {
+                    let pct = 100.0 * done as f64 / total.max(1) as f64;
+                    ui.label(format!("rendering {}: {pct:.0}%", pass.label()));
+                    ui.add(egui::ProgressBar::new((pct / 100.0) as f32).desired_width(160.0));
+                }
+            }
+            Some((None, ..)) => {
+                ui.label("starting…");
+            }
+            None => {
+                ui.label("rendering…");
+            }
+        }
+        if let Some(m) = app.messages().last() {
+            ui.separator();
+            let color = if m.is_error {
+                Color32::from_rgb(230, 80, 60)
+            } else {
+                ui.visuals().text_color()
+            };
+            ui.label(RichText::new(&m.text).color(color));
+        }
+        let _ = app.uptime();
+    });
+}

@@ -1,0 +1,447 @@
+//! The render worker: a thread that refines the image progressively (a
+//! 1-sample pass, then the 16-sample pass) tile by tile into a shared
+//! display buffer, and abandons stale work within one tile.
+//!
+//! The UI never waits on it: it publishes a job and bumps the generation
+//! counter; tiles of an older generation are dropped. The buffer's lock is
+//! held only to copy one finished tile in or the display image out.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::mpsc::{Receiver, Sender, channel};
+use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use rayon::prelude::*;
+
+use crate::accel::Octree;
+use crate::camera::CameraSpec;
+use crate::math::DVec3;
+use crate::render::{Frame, RenderSettings, Renderer, TileCounts, ViewMode, tiles};
+use crate::scene::Scene;
+use crate::stats::RayCounts;
+
+/// What to render. `settings.samples` is ignored: the worker runs the
+/// 1-sample pass, then the 16-sample pass if `anti_aliasing`.
+#[derive(Clone)]
+pub struct Job {
+    pub scene: Arc<Scene>,
+    pub octree: Arc<Octree>,
+    pub camera: CameraSpec,
+    pub settings: RenderSettings,
+    pub anti_aliasing: bool,
+    /// Render only a 1-sample pass at 1/`preview_divisor` of the resolution
+    /// (used while the user drags); 1 = the full progressive sequence.
+    pub preview_divisor: u32,
+}
+
+/// Which pass produced a buffer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PassKind {
+    Preview { divisor: u32 },
+    OneSample,
+    SixteenSamples,
+}
+
+impl PassKind {
+    pub fn label(self) -> String {
+        match self {
+            PassKind::Preview { divisor } => format!("preview 1/{divisor}"),
+            PassKind::OneSample => "1 sample".into(),
+            PassKind::SixteenSamples => "16 samples".into(),
+        }
+    }
+}
+
+/// A finished pass, for the timing panel and plot.
+#[derive(Clone, Copy, Debug)]
+pub struct PassRecord {
+    pub generation: u64,
+    pub kind: PassKind,
+    pub seconds: f64,
+    pub rays: RayCounts,
+    pub octree: bool,
+    pub anti_aliasing: bool,
+    pub width: u32,
+    pub height: u32,
+    /// Seconds since the worker started, when the pass finished.
+    pub finished_at: f64,
+}
+
+/// The display buffer: RGBA8, exactly what the viewer shows and exports.
+#[derive(Clone, Debug, Default)]
+pub struct DisplayBuffer {
+    pub generation: u64,
+    pub width: u32,
+    pub height: u32,
+    pub rgba: Vec<u8>,
+    /// Bumped on every change, so the UI uploads the texture only when new
+    /// tiles arrived.
+    pub version: u64,
+    pub pass: Option<PassKind>,
+    /// The pass currently being rendered and its progress in tiles.
+    pub tiles_done: u64,
+    pub tiles_total: u64,
+    /// True when the last pass of the generation is complete.
+    pub finished: bool,
+    /// The linear-light frame of the last completed pass (for exact comparisons).
+    pub last_frame: Option<Frame>,
+}
+
+struct Shared {
+    generation: AtomicU64,
+    buffer: Mutex<DisplayBuffer>,
+    history: Mutex<Vec<PassRecord>>,
+    repaint: Box<dyn Fn() + Send + Sync>,
+    started: Instant,
+    /// Tiles started per generation (for the cancellation test and stats).
+    tiles_started: Mutex<Vec<(u64, u64)>>,
+    /// When the UI was last asked to repaint for new tiles.
+    last_repaint: Mutex<Instant>,
+}
+
+/// Tiles arrive far faster than a screen refreshes; asking for a repaint
+/// per tile would make the UI thread (and a software OpenGL under Xvfb)
+/// compete with the renderer for the cores. 30 repaints a second suffice.
+const REPAINT_INTERVAL: Duration = Duration::from_millis(33);
+
+impl Shared {
+    fn repaint_soon(&self) {
+        let mut last = self.last_repaint.lock().unwrap_or_else(|e| e.into_inner());
+        if last.elapsed() >= REPAINT_INTERVAL {
+            *last = Instant::now();
+            drop(last);
+            (self.repaint)();
+        }
+    }
+}
+
+/// Handle owned by the UI. Dropping it stops and joins the thread.
+pub struct Worker {
+    shared: Arc<Shared>,
+    jobs: Option<Sender<(u64, Job)>>,
+    thread: Option<JoinHandle<()>>,
+}
+
+impl Worker {
+    /// `repaint` is called whenever the display buffer changed (egui's
+    /// `Context::request_repaint`, so an idle viewer does no work).
+    pub fn spawn(threads: usize, repaint: impl Fn() + Send + Sync + 'static) -> Self {
+        let shared = Arc::new(Shared {
+            generation: AtomicU64::new(0),
+            buffer: Mutex::new(DisplayBuffer::default()),
+            history: Mutex::new(Vec::new()),
+            repaint: Box::new(repaint),
+            started: Instant::now(),
+            tiles_started: Mutex::new(Vec::new()),
+            last_repaint: Mutex::new(Instant::now()),
+        });
+        let (tx, rx) = channel();
+        let thread_shared = Arc::clone(&shared);
+        let thread = std::thread::Builder::new()
+            .name("glint-render".into())
+            .spawn(move || run(thread_shared, rx, threads))
+            .ok();
+        Self {
+            shared,
+            jobs: Some(tx),
+            thread,
+        }
+    }
+
+    /// Starts rendering `job`, abandoning whatever was in flight. Returns
+    /// the job's generation.
+    pub fn submit(&self, job: Job) -> u64 {
+        let generation = self.shared.generation.fetch_add(1, Ordering::SeqCst) + 1;
+        if let Some(tx) = &self.jobs {
+            let _ = tx.send((generation, job));
+        }
+        generation
+    }
+
+    pub fn generation(&self) -> u64 {
+        self.shared.generation.load(Ordering::SeqCst)
+    }
+
+    /// Calls `f` with the buffer if the lock is free; the UI never waits.
+    pub fn try_with_buffer<R>(&self, f: impl FnOnce(&DisplayBuffer) -> R) -> Option<R> {
+        self.shared.buffer.try_lock().ok().map(|b| f(&b))
+    }
+
+    /// Waits for the lock (tests and export only).
+    pub fn with_buffer<R>(&self, f: impl FnOnce(&DisplayBuffer) -> R) -> R {
+        let guard = self.shared.buffer.lock().unwrap_or_else(|e| e.into_inner());
+        f(&guard)
+    }
+
+    /// How many tiles of generation `generation` were started, all passes.
+    pub fn tiles_started(&self, generation: u64) -> u64 {
+        let list = self
+            .shared
+            .tiles_started
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        list.iter()
+            .find(|(g, _)| *g == generation)
+            .map_or(0, |(_, n)| *n)
+    }
+
+    pub fn history(&self) -> Vec<PassRecord> {
+        self.shared
+            .history
+            .lock()
+            .map(|h| h.clone())
+            .unwrap_or_default()
+    }
+
+    /// Blocks until generation `generation` has finished its last pass
+    /// (tests and `--screenshot`), or the timeout passes.
+    pub fn wait_finished(&self, generation: u64, timeout: Duration) -> bool {
+        let start = Instant::now();
+        while start.elapsed() < timeout {
+            if self.with_buffer(|b| b.generation == generation && b.finished) {
+                return true;
+            }
+            std::thread::sleep(Duration::from_millis(2));
+        }
+        false
+    }
+}
+
+impl Drop for Worker {
+    fn drop(&mut self) {
+        // Cancel the work in flight, close the channel, then join.
+        self.shared.generation.fetch_add(1, Ordering::SeqCst);
+        self.jobs.take();
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+fn run(shared: Arc<Shared>, rx: Receiver<(u64, Job)>, threads: usize) {
+    let pool = match rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .thread_name(|i| format!("glint-tile-{i}"))
+        .build()
+    {
+        Ok(p) => p,
+        Err(_) => return,
+    };
+    while let Ok(mut next) = rx.recv() {
+        // Only the newest job matters.
+        while let Ok(newer) = rx.try_recv() {
+            next = newer;
+        }
+        let (generation, job) = next;
+        if shared.generation.load(Ordering::SeqCst) != generation {
+            continue;
+        }
+        pool.install(|| render_job(&shared, generation, &job));
+    }
+}
+
+fn render_job(shared: &Shared, generation: u64, job: &Job) {
+    let passes: Vec<PassKind> = if job.preview_divisor > 1 {
+        vec![PassKind::Preview {
+            divisor: job.preview_divisor,
+        }]
+    } else if job.anti_aliasing {
+        vec![PassKind::OneSample, PassKind::SixteenSamples]
+    } else {
+        vec![PassKind::OneSample]
+    };
+    let last = passes.len() - 1;
+    for (index, &kind) in passes.iter().enumerate() {
+        let mut settings = job.settings;
+        settings.samples = if kind == PassKind::SixteenSamples {
+            16
+        } else {
+            1
+        };
+        if let PassKind::Preview { divisor } = kind {
+            settings.width = (settings.width / divisor).max(1);
+            settings.height = (settings.height / divisor).max(1);
+        }
+        if !render_pass(shared, generation, job, settings, kind, index == last) {
+            return;
+        }
+    }
+}
+
+/// Renders one pass; `false` if it was cancelled.
+fn render_pass(
+    shared: &Shared,
+    generation: u64,
+    job: &Job,
+    settings: RenderSettings,
+    kind: PassKind,
+    last: bool,
+) -> bool {
+    let stale = || shared.generation.load(Ordering::SeqCst) != generation;
+    let Ok(renderer) = Renderer::with_camera(&job.scene, &job.octree, settings, &job.camera) else {
+        return false;
+    };
+    let (w, h) = (settings.width, settings.height);
+    let all = tiles(w, h);
+    {
+        let mut b = shared.buffer.lock().unwrap_or_else(|e| e.into_inner());
+        // A new image size starts from black; otherwise the previous pass
+        // stays visible under the tiles that sweep in.
+        if b.width != w || b.height != h || b.rgba.len() != (w * h * 4) as usize {
+            b.width = w;
+            b.height = h;
+            b.rgba = vec![0; (w * h * 4) as usize];
+            for px in b.rgba.chunks_exact_mut(4) {
+                px[3] = 255;
+            }
+        }
+        b.generation = generation;
+        b.pass = Some(kind);
+        b.tiles_done = 0;
+        b.tiles_total = all.len() as u64;
+        b.finished = false;
+        b.version += 1;
+    }
+    let start = Instant::now();
+    let done = AtomicU64::new(0);
+    let depth_range = Mutex::new((f64::INFINITY, f64::NEG_INFINITY));
+    let results: Vec<Option<(Vec<DVec3>, TileCounts)>> = all
+        .par_iter()
+        .map(|&tile| {
+            // The cancellation point: at most one tile per thread is wasted.
+            if stale() {
+                return None;
+            }
+            count_tile(shared, generation);
+            let (values, counts) = renderer.render_tile(tile, false);
+            let rgba = tile_rgba(&values, settings.view, &depth_range);
+            {
+                let mut b = shared.buffer.lock().unwrap_or_else(|e| e.into_inner());
+                if b.generation == generation && b.width == w {
+                    for row in 0..tile.height {
+                        let dst = (((tile.y + row) * w + tile.x) * 4) as usize;
+                        let src = (row * tile.width * 4) as usize;
+                        let n = (tile.width * 4) as usize;
+                        b.rgba[dst..dst + n].copy_from_slice(&rgba[src..src + n]);
+                    }
+                    b.tiles_done = done.fetch_add(1, Ordering::Relaxed) + 1;
+                    b.version += 1;
+                }
+            }
+            shared.repaint_soon();
+            Some((values, counts))
+        })
+        .collect();
+    if stale() || results.iter().any(Option::is_none) {
+        return false;
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    // Assemble the exact frame, as `glint render` would, and publish it.
+    let mut pixels = vec![DVec3::ZERO; (w * h) as usize];
+    let mut counts = TileCounts::default();
+    for (tile, (values, c)) in all.iter().zip(results.into_iter().flatten()) {
+        counts += c;
+        for row in 0..tile.height {
+            let start = ((tile.y + row) * w + tile.x) as usize;
+            let src = (row * tile.width) as usize;
+            pixels[start..start + tile.width as usize]
+                .copy_from_slice(&values[src..src + tile.width as usize]);
+        }
+    }
+    let frame = Frame {
+        width: w,
+        height: h,
+        view: settings.view,
+        pixels,
+    };
+    let rgba = rgb_to_rgba(&frame.to_rgb8());
+    {
+        let mut b = shared.buffer.lock().unwrap_or_else(|e| e.into_inner());
+        if b.generation != generation {
+            return false;
+        }
+        b.rgba = rgba;
+        b.finished = last;
+        b.last_frame = Some(frame);
+        b.version += 1;
+    }
+    if let Ok(mut history) = shared.history.lock() {
+        history.push(PassRecord {
+            generation,
+            kind,
+            seconds,
+            rays: counts.rays,
+            octree: settings.use_octree,
+            anti_aliasing: job.anti_aliasing,
+            width: w,
+            height: h,
+            finished_at: shared.started.elapsed().as_secs_f64(),
+        });
+    }
+    (shared.repaint)();
+    true
+}
+
+fn count_tile(shared: &Shared, generation: u64) {
+    let mut list = shared
+        .tiles_started
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
+    match list.iter_mut().find(|(g, _)| *g == generation) {
+        Some((_, n)) => *n += 1,
+        None => {
+            list.push((generation, 1));
+            // Keep the record short: only recent generations matter.
+            if list.len() > 64 {
+                list.remove(0);
+            }
+        }
+    }
+}
+
+/// Display bytes of one tile. Depth is normalised by the range seen so far
+/// (the finished pass replaces it with the exact full-frame normalisation).
+fn tile_rgba(values: &[DVec3], view: ViewMode, depth_range: &Mutex<(f64, f64)>) -> Vec<u8> {
+    let rgb = match view {
+        ViewMode::Depth => {
+            let (near, far) = {
+                let mut r = depth_range.lock().unwrap_or_else(|e| e.into_inner());
+                for v in values.iter().filter(|v| v.y > 0.0) {
+                    r.0 = r.0.min(v.x);
+                    r.1 = r.1.max(v.x);
+                }
+                *r
+            };
+            let mut frame = Frame {
+                width: values.len() as u32,
+                height: 1,
+                view,
+                pixels: values.to_vec(),
+            };
+            // Two sentinel pixels pin the normalisation to the running range.
+            frame.pixels.push(DVec3::new(near, 1.0, 0.0));
+            frame.pixels.push(DVec3::new(far, 1.0, 0.0));
+            frame.width += 2;
+            let mut bytes = frame.to_rgb8();
+            bytes.truncate(values.len() * 3);
+            bytes
+        }
+        _ => Frame {
+            width: values.len() as u32,
+            height: 1,
+            view,
+            pixels: values.to_vec(),
+        }
+        .to_rgb8(),
+    };
+    rgb_to_rgba(&rgb)
+}
+
+pub fn rgb_to_rgba(rgb: &[u8]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(rgb.len() / 3 * 4);
+    for p in rgb.chunks_exact(3) {
+        out.extend_from_slice(&[p[0], p[1], p[2], 255]);
+    }
+    out
+}
