@@ -510,6 +510,27 @@ impl GlintApp {
             return;
         }
         if self.final_pass_shown() {
+            if self.frames_since_final == 0 {
+                // Report the passes of the shown image: the measured time to
+                // the first and the final pass.
+                let generation = self.worker.generation();
+                for r in self
+                    .worker
+                    .history()
+                    .iter()
+                    .filter(|r| r.generation == generation)
+                {
+                    eprintln!(
+                        "glint: {} pass {}x{}: {:.3} s, {:.2} Mrays/s, octree {}",
+                        r.kind.label(),
+                        r.width,
+                        r.height,
+                        r.seconds,
+                        r.rays.total() as f64 / r.seconds.max(1e-9) / 1e6,
+                        if r.octree { "on" } else { "off" }
+                    );
+                }
+            }
             self.frames_since_final += 1;
             if self.frames_since_final >= self.options.frames.max(1) {
                 self.screenshot_requested = true;

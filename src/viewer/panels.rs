@@ -59,7 +59,11 @@ fn color_ui(ui: &mut egui::Ui, label: &str, c: &mut DVec3) -> bool {
     let mut changed = false;
     ui.horizontal(|ui| {
         ui.label(label);
-        if ui.color_edit_button_rgb(&mut rgb).changed() {
+        if ui
+            .color_edit_button_rgb(&mut rgb)
+            .accessible_name(label)
+            .changed()
+        {
             changed = true;
         }
     });
