@@ -129,7 +129,7 @@ fn quadric_sphere_renders_like_the_analytic_sphere() {
     else {
         panic!("the first object of sphere.toml is the sphere");
     };
-    scene.shapes[0] = Shape::Quadric(Quadric::new(
+    scene.shapes[0] = Shape::Quadric(Box::new(Quadric::new(
         [
             1.0,
             0.0,
@@ -143,7 +143,7 @@ fn quadric_sphere_renders_like_the_analytic_sphere() {
             c.length_squared() - r * r,
         ],
         None,
-    ));
+    )));
     let octree = Octree::build(&scene.shapes, scene.octree_params);
     let (quadric, _) = render_with(&scene, &octree, 160, 120, |s| s.samples = 16);
     let (over_one, largest) = diff(&analytic, &quadric, 0);

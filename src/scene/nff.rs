@@ -329,7 +329,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 let cone = Cone::new(base, base_radius, apex, apex_radius).ok_or_else(|| {
                     tokens.error_at(line, column, "c", "cone base and apex coincide")
                 })?;
-                scene.push(Shape::Cone(cone), m);
+                scene.push(Shape::Cone(Box::new(cone)), m);
             }
             "p" | "pp" => {
                 let with_normals = keyword == "pp";

@@ -459,7 +459,10 @@ fn add_object(
                     Some(b)
                 }
             };
-            scene.push(Shape::Quadric(Quadric::new(coefficients, clip)), material);
+            scene.push(
+                Shape::Quadric(Box::new(Quadric::new(coefficients, clip))),
+                material,
+            );
         }
         "mesh" => {
             required("path", obj.path.is_some())?;

@@ -90,8 +90,10 @@ pub enum Shape {
     Sphere(Sphere),
     Plane(Plane),
     Triangle(Triangle),
-    Quadric(Quadric),
-    Cone(Cone),
+    // The rarer, larger shapes are boxed so that the common ones (triangles,
+    // spheres) pack densely: `Shape` is 80 bytes instead of 144.
+    Quadric(Box<Quadric>),
+    Cone(Box<Cone>),
 }
 
 impl Shape {

@@ -10,29 +10,67 @@ use crate::math::{Aabb, DVec3, Ray, solve_quadratic_half};
 /// written. Substituting the ray `o + t d` gives `Aq t^2 + Bq t + Cq = 0`
 /// with `Aq = Q(d)`, `Bq = grad F(o) . d` and `Cq = F(o)`, where `Q` is the
 /// quadratic part; the normal is `grad F`.
+///
+/// Precision far from the origin: evaluating `F` at a point 1e6 from the
+/// origin sums terms of 1e12 whose rounding (about 1e-4) swamps the value
+/// near the surface, so a shadow ray could not tell which side it starts
+/// on. glint therefore re-centres each quadric at load on a local origin
+/// (its clip box's centre, or the centre of a central quadric) and
+/// evaluates `F` in local coordinates, where the terms are of the size of
+/// the object. The re-centred constant carries the rounding of the world
+/// coefficients once, as a shift of the surface far below a pixel.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Quadric {
-    /// `[A, B, C, D, E, F, G, H, I, J]`.
+    /// `[A, B, C, D, E, F, G, H, I, J]` in world coordinates, as given.
     pub coefficients: [f64; 10],
     pub clip: Option<Aabb>,
+    /// The local origin and the coefficients about it: `F(p) = G(p - origin)`.
+    origin: DVec3,
+    local: [f64; 10],
 }
 
 impl Quadric {
     pub fn new(coefficients: [f64; 10], clip: Option<Aabb>) -> Self {
-        Self { coefficients, clip }
+        let origin = clip
+            .map(|c| c.center())
+            .or_else(|| central_point(&coefficients))
+            .unwrap_or(DVec3::ZERO);
+        let [a, b, c, _, e, f, _, h, _, _] = coefficients;
+        let world = Self {
+            coefficients,
+            clip,
+            origin: DVec3::ZERO,
+            local: coefficients,
+        };
+        // The quadratic part is unchanged; the linear part is grad F(origin),
+        // the constant F(origin).
+        let g = world.gradient(origin);
+        let local = [a, b, c, g.x, e, f, g.y, h, g.z, world.value(origin)];
+        if local.iter().all(|x| x.is_finite()) {
+            Self {
+                coefficients,
+                clip,
+                origin,
+                local,
+            }
+        } else {
+            world
+        }
     }
 
     /// `F(p)`.
     pub fn value(&self, p: DVec3) -> f64 {
-        let [a, b, c, d, e, f, g, h, i, j] = self.coefficients;
-        let (x, y, z) = (p.x, p.y, p.z);
+        let [a, b, c, d, e, f, g, h, i, j] = self.local;
+        let q = p - self.origin;
+        let (x, y, z) = (q.x, q.y, q.z);
         x * (a * x + b * y + c * z + d) + y * (e * y + f * z + g) + z * (h * z + i) + j
     }
 
     /// `grad F(p)`.
     pub fn gradient(&self, p: DVec3) -> DVec3 {
-        let [a, b, c, d, e, f, g, h, i, _] = self.coefficients;
-        let (x, y, z) = (p.x, p.y, p.z);
+        let [a, b, c, d, e, f, g, h, i, _] = self.local;
+        let q = p - self.origin;
+        let (x, y, z) = (q.x, q.y, q.z);
         DVec3::new(
             2.0 * a * x + b * y + c * z + d,
             b * x + 2.0 * e * y + f * z + g,
@@ -42,7 +80,7 @@ impl Quadric {
 
     /// The quadratic part `Q(d)`.
     fn quadratic_form(&self, d: DVec3) -> f64 {
-        let [a, b, c, _, e, f, _, h, _, _] = self.coefficients;
+        let [a, b, c, _, e, f, _, h, _, _] = self.local;
         d.x * (a * d.x + b * d.y + c * d.z) + d.y * (e * d.y + f * d.z) + h * d.z * d.z
     }
 
@@ -92,6 +130,25 @@ impl Quadric {
             shading_normal: normal,
         }
     }
+}
+
+/// The centre of a central quadric (where its gradient vanishes, solving
+/// `2 Q x = -l`), if `Q` is well conditioned; `None` for paraboloids,
+/// cylinders and other quadrics without a unique centre.
+fn central_point(k: &[f64; 10]) -> Option<DVec3> {
+    let [a, b, c, d, e, f, g, h, i, _] = *k;
+    let q = glam::DMat3::from_cols(
+        DVec3::new(2.0 * a, b, c),
+        DVec3::new(b, 2.0 * e, f),
+        DVec3::new(c, f, 2.0 * h),
+    );
+    let det = q.determinant();
+    let scale = q.to_cols_array().iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if !(det.abs() > 1e-9 * scale * scale * scale) {
+        return None;
+    }
+    let centre = q.inverse() * -DVec3::new(d, g, i);
+    centre.is_finite().then_some(centre)
 }
 
 #[cfg(test)]
@@ -154,6 +211,21 @@ mod tests {
             let n = scaled.surface(&ray, &h).geometric_normal;
             assert!((n.z.abs() - q.surface(&ray, &base).geometric_normal.z).abs() < 1e-12);
         }
+    }
+
+    #[test]
+    fn far_from_the_origin_the_side_of_a_point_is_still_known() {
+        // A unit sphere 1e6 from the origin: 1e-7 off its surface, F must
+        // have the right sign (world-space evaluation would be noise).
+        let c = DVec3::new(1e6, -1e6, 1e6);
+        let q = sphere_quadric(c, 1.0);
+        let outside = c + DVec3::X * (1.0 + 1e-7);
+        let inside = c + DVec3::X * (1.0 - 1e-7);
+        assert!(q.value(outside) > 0.0 && q.value(inside) < 0.0);
+        assert_eq!(
+            central_point(&q.coefficients).map(|p| (p - c).length() < 1e-6),
+            Some(true)
+        );
     }
 
     #[test]

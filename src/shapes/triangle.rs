@@ -7,8 +7,6 @@ pub const NO_NORMALS: u32 = u32::MAX;
 #[derive(Clone, Debug, PartialEq)]
 pub struct Triangle {
     pub vertices: [DVec3; 3],
-    /// Unit geometric normal (counter-clockwise winding faces it).
-    pub normal: DVec3,
     /// Index into the scene's per-triangle vertex normals, or [`NO_NORMALS`].
     pub vertex_normals: u32,
 }
@@ -23,17 +21,22 @@ impl Triangle {
             return None;
         }
         let (e1, e2) = (b - a, c - a);
-        let cross = e1.cross(e2);
-        let len = cross.length();
+        let len = e1.cross(e2).length();
         // Relative to the edges: the sine of the angle at vertex 0.
         if !(len > 1e-12 * e1.length() * e2.length()) {
             return None;
         }
         Some(Self {
             vertices,
-            normal: cross / len,
             vertex_normals: NO_NORMALS,
         })
+    }
+
+    /// Unit geometric normal; the counter-clockwise winding faces it.
+    /// Computed when needed (once per shaded hit) to keep the triangle small.
+    pub fn normal(&self) -> DVec3 {
+        let [a, b, c] = self.vertices;
+        (b - a).cross(c - a).normalize()
     }
 
     /// Watertight ray/triangle intersection: Woop, Benthin & Wald,
@@ -77,13 +80,14 @@ impl Triangle {
         // Interpolating the vertices gives a point whose error is bounded by
         // the vertices' magnitude (Wächter & Binder, RTG ch. 6).
         let point = b0 * v0 + hit.b1 * v1 + hit.b2 * v2;
+        let normal = self.normal();
         let shading_normal = vertex_normals
             .get(self.vertex_normals as usize)
             .and_then(|[n0, n1, n2]| super::unit_or_none(b0 * *n0 + hit.b1 * *n1 + hit.b2 * *n2))
-            .unwrap_or(self.normal);
+            .unwrap_or(normal);
         Surface {
             point,
-            geometric_normal: self.normal,
+            geometric_normal: normal,
             shading_normal,
         }
     }

@@ -4,6 +4,7 @@
 mod bench;
 mod common;
 mod render_cmd;
+mod study;
 #[cfg(feature = "gui")]
 mod view;
 
@@ -26,6 +27,8 @@ enum Command {
     Render(render_cmd::RenderArgs),
     /// Time scenes with the octree on and off, interleaved, and report medians.
     Bench(bench::BenchArgs),
+    /// Measure speed against accuracy: anti-aliasing, depth, octree, preview.
+    Study(study::StudyArgs),
     /// Open a scene in the interactive viewer (the default command).
     #[cfg(feature = "gui")]
     View(view::ViewArgs),
@@ -36,6 +39,7 @@ fn main() -> std::process::ExitCode {
     let result = match cli.command {
         Some(Command::Render(args)) => render_cmd::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
+        Some(Command::Study(args)) => study::run(&args),
         #[cfg(feature = "gui")]
         Some(Command::View(args)) => view::run(&args),
         #[cfg(feature = "gui")]

@@ -1,0 +1,389 @@
+//! `glint study`: how much accuracy each speed knob buys, measured.
+//!
+//! For each scene: anti-aliasing (1, 4, 16, 64 samples against a 256-sample
+//! reference), recursion depth (1 to 8 against 12), octree parameters, and
+//! preview resolution (1/1, 1/2, 1/4 against the full-resolution image).
+//! Writes `DIR/study.md` and difference images `DIR/*.png`.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use glint::accel::{Octree, OctreeParams};
+use glint::math::DVec3;
+use glint::render::{Frame, RenderSettings, Renderer, linear_to_srgb};
+use glint::scene::Scene;
+
+use crate::common::{load_scene, parse_positive, thread_pool};
+
+#[derive(clap::Args)]
+pub struct StudyArgs {
+    /// Scene files (.toml or .nff).
+    #[arg(required = true)]
+    pub scenes: Vec<PathBuf>,
+    /// Output directory for study.md and the images.
+    #[arg(long, default_value = "study")]
+    pub out: PathBuf,
+    /// Image size as WIDTHxHEIGHT (default: 320x240).
+    #[arg(long, default_value = "320x240")]
+    pub size: String,
+    /// Timed runs per configuration (the median is reported).
+    #[arg(long, default_value_t = 3, value_parser = parse_positive)]
+    pub repeat: u32,
+    /// Render threads (default: one per core).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+}
+
+/// Root-mean-square error and PSNR of `a` against `reference`, in linear
+/// light and after sRGB encoding (both on [0, 1], channels clamped).
+#[derive(Clone, Copy, Debug)]
+pub struct ImageError {
+    pub rmse_linear: f64,
+    pub psnr_linear: f64,
+    pub rmse_srgb: f64,
+    pub psnr_srgb: f64,
+    /// Fraction of pixels differing by more than 1/255 in sRGB.
+    pub visible_fraction: f64,
+}
+
+pub fn image_error(a: &[DVec3], reference: &[DVec3]) -> ImageError {
+    let (mut lin, mut srgb, mut visible) = (0.0, 0.0, 0usize);
+    for (p, q) in a.iter().zip(reference) {
+        let (p, q) = (
+            p.clamp(DVec3::ZERO, DVec3::ONE),
+            q.clamp(DVec3::ZERO, DVec3::ONE),
+        );
+        lin += (p - q).length_squared();
+        let enc = |v: DVec3| {
+            DVec3::new(
+                linear_to_srgb(v.x),
+                linear_to_srgb(v.y),
+                linear_to_srgb(v.z),
+            )
+        };
+        let d = enc(p) - enc(q);
+        srgb += d.length_squared();
+        if d.abs().max_element() > 1.0 / 255.0 {
+            visible += 1;
+        }
+    }
+    let n = (a.len() * 3).max(1) as f64;
+    let (rl, rs) = ((lin / n).sqrt(), (srgb / n).sqrt());
+    let psnr = |r: f64| {
+        if r > 0.0 {
+            -20.0 * r.log10()
+        } else {
+            f64::INFINITY
+        }
+    };
+    ImageError {
+        rmse_linear: rl,
+        psnr_linear: psnr(rl),
+        rmse_srgb: rs,
+        psnr_srgb: psnr(rs),
+        visible_fraction: visible as f64 / a.len().max(1) as f64,
+    }
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+struct Study<'a> {
+    scene: &'a Scene,
+    octree: Octree,
+
+    repeat: u32,
+    pool: rayon::ThreadPool,
+}
+
+impl Study<'_> {
+    /// Median time and the frame of a render with `settings`.
+    fn run(&self, settings: RenderSettings, octree: Option<&Octree>) -> Result<(f64, Frame)> {
+        let octree = octree.unwrap_or(&self.octree);
+        let renderer = Renderer::new(self.scene, octree, settings)?;
+        let mut times = Vec::new();
+        let mut frame = None;
+        for _ in 0..self.repeat {
+            let start = Instant::now();
+            let (f, _) = self.pool.install(|| renderer.render(false, None));
+            times.push(start.elapsed().as_secs_f64());
+            frame = Some(f);
+        }
+        Ok((median(times), frame.context("no repeats")?))
+    }
+}
+
+/// Upsamples a frame by pixel replication to `width` x `height`, as the
+/// viewer shows a reduced-resolution preview.
+fn upsample(f: &Frame, width: u32, height: u32) -> Vec<DVec3> {
+    let mut out = Vec::with_capacity((width * height) as usize);
+    for y in 0..height {
+        let sy = (y as u64 * f.height as u64 / height as u64) as u32;
+        for x in 0..width {
+            let sx = (x as u64 * f.width as u64 / width as u64) as u32;
+            out.push(f.pixels[(sy * f.width + sx) as usize]);
+        }
+    }
+    out
+}
+
+/// Writes `|a - b|` (sRGB-encoded difference, scaled by `gain`) as a PNG.
+fn save_difference(
+    a: &[DVec3],
+    b: &[DVec3],
+    width: u32,
+    height: u32,
+    gain: f64,
+    path: &Path,
+) -> Result<()> {
+    let enc = |v: DVec3| {
+        DVec3::new(
+            linear_to_srgb(v.x),
+            linear_to_srgb(v.y),
+            linear_to_srgb(v.z),
+        )
+    };
+    let bytes: Vec<u8> = a
+        .iter()
+        .zip(b)
+        .flat_map(|(p, q)| {
+            let d = (enc(*p) - enc(*q)).abs() * gain;
+            [d.x, d.y, d.z].map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8)
+        })
+        .collect();
+    image::RgbImage::from_raw(width, height, bytes)
+        .context("image size")?
+        .save(path)
+        .with_context(|| format!("cannot write {}", path.display()))
+}
+
+pub fn run(args: &StudyArgs) -> Result<()> {
+    let (w, h) = args
+        .size
+        .split_once('x')
+        .and_then(|(a, b)| Some((a.parse::<u32>().ok()?, b.parse::<u32>().ok()?)))
+        .filter(|&(a, b)| a > 0 && b > 0)
+        .with_context(|| format!("--size expects WIDTHxHEIGHT, got `{}`", args.size))?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let mut md = String::new();
+    writeln!(md, "# glint study\n")?;
+    writeln!(
+        md,
+        "Regenerate with `glint study {} --out {} --size {} --repeat {}`. Times are medians of {} runs on this machine \
+         ({} threads); errors are against a reference render of the same scene.\n",
+        args.scenes
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(" "),
+        args.out.display(),
+        args.size,
+        args.repeat,
+        args.repeat,
+        thread_pool(args.threads)?.current_num_threads()
+    )?;
+    let mut summary = Vec::new();
+    for path in &args.scenes {
+        let (scene, _) = load_scene(path)?;
+        let stem = path
+            .file_stem()
+            .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+        eprintln!("study {}", path.display());
+        let mut base = RenderSettings::from_scene(&scene);
+        (base.width, base.height) = (w, h);
+        base.use_octree = true;
+        let study = Study {
+            octree: Octree::build(&scene.shapes, scene.octree_params),
+            scene: &scene,
+            repeat: args.repeat,
+            pool: thread_pool(args.threads)?,
+        };
+        writeln!(md, "## {}\n", path.display())?;
+
+        // Anti-aliasing.
+        let (_, reference) = study.run(
+            RenderSettings {
+                samples: 256,
+                ..base
+            },
+            None,
+        )?;
+        writeln!(
+            md,
+            "### Anti-aliasing (reference: 256 samples, 16x16 grid)\n"
+        )?;
+        writeln!(
+            md,
+            "| samples | grid | time (s) | time vs 1 | RMSE linear | PSNR linear (dB) | RMSE sRGB | PSNR sRGB (dB) | pixels off by > 1/255 |"
+        )?;
+        writeln!(md, "|---:|---|---:|---:|---:|---:|---:|---:|---:|")?;
+        let mut one = None;
+        let mut t_one = 1.0;
+        for samples in [1u32, 4, 16, 64] {
+            let (t, f) = study.run(RenderSettings { samples, ..base }, None)?;
+            if samples == 1 {
+                t_one = t;
+            }
+            let e = image_error(&f.pixels, &reference.pixels);
+            let k = (samples as f64).sqrt() as u32;
+            writeln!(
+                md,
+                "| {samples} | {k}x{k} | {t:.3} | {:.1}x | {:.4} | {:.1} | {:.4} | {:.1} | {:.1}% |",
+                t / t_one,
+                e.rmse_linear,
+                e.psnr_linear,
+                e.rmse_srgb,
+                e.psnr_srgb,
+                100.0 * e.visible_fraction
+            )?;
+            if samples == 1 {
+                one = Some(f);
+            } else if samples == 16 {
+                if let Some(one) = &one {
+                    let need = args.out.join(format!("{stem}-aa-need.png"));
+                    save_difference(&one.pixels, &f.pixels, w, h, 4.0, &need)?;
+                    let e = image_error(&one.pixels, &f.pixels);
+                    writeln!(md, "\n")?;
+                    summary.push((
+                        stem.clone(),
+                        "1 vs 16 samples: pixels anti-aliasing changes".to_string(),
+                        format!("{:.1}%", 100.0 * e.visible_fraction),
+                    ));
+                    summary.push((
+                        stem.clone(),
+                        "16 / 1 sample time".into(),
+                        format!("{:.1}x", t / t_one),
+                    ));
+                }
+            }
+        }
+        writeln!(
+            md,
+            "\n![anti-aliasing need]({stem}-aa-need.png) — |1 sample − 16 samples| in sRGB, gain 4.\n"
+        )?;
+
+        // Recursion depth.
+        let (_, deep) = study.run(
+            RenderSettings {
+                max_depth: 12,
+                samples: 1,
+                ..base
+            },
+            None,
+        )?;
+        writeln!(md, "### Recursion depth (reference: depth 12, 1 sample)\n")?;
+        writeln!(
+            md,
+            "| max depth | time (s) | RMSE sRGB | PSNR sRGB (dB) | pixels off by > 1/255 |"
+        )?;
+        writeln!(md, "|---:|---:|---:|---:|---:|")?;
+        for depth in 1..=8 {
+            let (t, f) = study.run(
+                RenderSettings {
+                    max_depth: depth,
+                    samples: 1,
+                    ..base
+                },
+                None,
+            )?;
+            let e = image_error(&f.pixels, &deep.pixels);
+            writeln!(
+                md,
+                "| {depth} | {t:.3} | {:.4} | {:.1} | {:.1}% |",
+                e.rmse_srgb,
+                e.psnr_srgb,
+                100.0 * e.visible_fraction
+            )?;
+            if depth == 3 {
+                summary.push((
+                    stem.clone(),
+                    "depth 3 vs 12: pixels off".into(),
+                    format!("{:.1}%", 100.0 * e.visible_fraction),
+                ));
+            }
+        }
+
+        // Octree parameters.
+        writeln!(md, "\n### Octree parameters (1 sample)\n")?;
+        writeln!(
+            md,
+            "| max depth | leaf size | build (s) | render (s) | memory (KiB) | tests per ray |"
+        )?;
+        writeln!(md, "|---:|---:|---:|---:|---:|---:|")?;
+        for max_depth in [4u32, 6, 8, 10, 12] {
+            for leaf_size in [2u32, 8, 32] {
+                let params = OctreeParams {
+                    max_depth,
+                    leaf_size,
+                    cost_driven: false,
+                };
+                let start = Instant::now();
+                let tree = study.pool.install(|| Octree::build(&scene.shapes, params));
+                let build = start.elapsed().as_secs_f64();
+                let (t, _) = study.run(RenderSettings { samples: 1, ..base }, Some(&tree))?;
+                let renderer = Renderer::new(&scene, &tree, RenderSettings { samples: 1, ..base })?;
+                let counts = study.pool.install(|| renderer.render(true, None).1);
+                writeln!(
+                    md,
+                    "| {max_depth} | {leaf_size} | {build:.4} | {t:.3} | {:.0} | {:.2} |",
+                    tree.stats().memory_bytes as f64 / 1024.0,
+                    counts.work.intersection_tests as f64 / counts.rays.total().max(1) as f64
+                )?;
+            }
+        }
+
+        // Preview resolution.
+        writeln!(
+            md,
+            "\n### Preview resolution (1 sample; error of the upscaled preview against full resolution)\n"
+        )?;
+        writeln!(
+            md,
+            "| resolution | pixels | time to image (s) | RMSE sRGB | PSNR sRGB (dB) | pixels off by > 1/255 |"
+        )?;
+        writeln!(md, "|---|---:|---:|---:|---:|---:|")?;
+        let full = one.as_ref().context("1-sample render")?;
+        for d in [1u32, 2, 4] {
+            let s = RenderSettings {
+                samples: 1,
+                width: (w / d).max(1),
+                height: (h / d).max(1),
+                ..base
+            };
+            let (t, f) = study.run(s, None)?;
+            let up = upsample(&f, w, h);
+            let e = image_error(&up, &full.pixels);
+            writeln!(
+                md,
+                "| 1/{d} | {}x{} | {t:.4} | {:.4} | {:.1} | {:.1}% |",
+                s.width,
+                s.height,
+                e.rmse_srgb,
+                e.psnr_srgb,
+                100.0 * e.visible_fraction
+            )?;
+            if d == 4 {
+                summary.push((
+                    stem.clone(),
+                    "1/4 preview: PSNR sRGB".into(),
+                    format!("{:.1} dB", e.psnr_srgb),
+                ));
+            }
+        }
+        writeln!(md)?;
+    }
+    let mut head = String::from("## Summary\n\n| scene | measure | value |\n|---|---|---:|\n");
+    for (scene, what, value) in &summary {
+        writeln!(head, "| {scene} | {what} | {value} |")?;
+    }
+    let out = args.out.join("study.md");
+    let text = md.replacen("\n## ", &format!("\n{head}\n## "), 1);
+    std::fs::write(&out, text).with_context(|| format!("cannot write {}", out.display()))?;
+    eprintln!("wrote {}", out.display());
+    Ok(())
+}

@@ -1,0 +1,347 @@
+//! Numerical robustness at the extremes. Every case asserts a property and
+//! reports what it measured when it fails.
+
+mod common;
+
+use common::{diff, load, render_with};
+use glint::accel::Octree;
+use glint::camera::{Camera, CameraSpec};
+use glint::math::{DVec3, Ray};
+use glint::render::{RenderSettings, Renderer};
+use glint::scene::Scene;
+use glint::shapes::{PreparedRay, Quadric, Shape, Sphere, Triangle};
+use proptest::prelude::*;
+
+/// The scene mapped by `p -> s p + t`: geometry, camera and lights.
+fn transformed(scene: &Scene, s: f64, t: DVec3) -> Scene {
+    let map = |p: DVec3| s * p + t;
+    let mut out = scene.clone();
+    out.camera.eye = map(scene.camera.eye);
+    out.camera.lookat = map(scene.camera.lookat);
+    for l in &mut out.lights {
+        l.position = map(l.position);
+    }
+    for shape in &mut out.shapes {
+        *shape = match shape.clone() {
+            Shape::Sphere(sp) => Shape::Sphere(Sphere::new(map(sp.center), s * sp.radius)),
+            Shape::Plane(p) => Shape::Plane(glint::shapes::Plane::new(map(p.point), p.normal)),
+            Shape::Triangle(tr) => {
+                let mut new = Triangle::new(tr.vertices.map(map)).expect("still a triangle");
+                new.vertex_normals = tr.vertex_normals;
+                Shape::Triangle(new)
+            }
+            Shape::Quadric(q) => Shape::Quadric(Box::new(transform_quadric(&q, s, t))),
+            Shape::Cone(c) => Shape::Cone(Box::new(
+                glint::shapes::Cone::new(
+                    map(c.base),
+                    s * c.base_radius,
+                    map(c.apex),
+                    s * c.apex_radius,
+                )
+                .unwrap(),
+            )),
+        };
+    }
+    out
+}
+
+/// `F'(p) = s^2 F((p - t) / s)`, expanded back into the ten coefficients.
+fn transform_quadric(q: &Quadric, s: f64, t: DVec3) -> Quadric {
+    let [a, b, c, d, e, f, g, h, i, j] = q.coefficients;
+    // F(p) = p.Q p + l.p + J with Q symmetric.
+    let qm = glam::DMat3::from_cols(
+        DVec3::new(a, b / 2.0, c / 2.0),
+        DVec3::new(b / 2.0, e, f / 2.0),
+        DVec3::new(c / 2.0, f / 2.0, h),
+    );
+    let l = DVec3::new(d, g, i);
+    let l2 = -2.0 * (qm * t) + s * l;
+    let j2 = t.dot(qm * t) - s * l.dot(t) + s * s * j;
+    let clip = q
+        .clip
+        .map(|b| glint::math::Aabb::new(s * b.min + t, s * b.max + t));
+    Quadric::new([a, b, c, l2.x, e, f, l2.y, h, l2.z, j2], clip)
+}
+
+fn render_scene(scene: &Scene, w: u32, h: u32) -> (Vec<u8>, u64) {
+    let octree = Octree::build(&scene.shapes, scene.octree_params);
+    let (img, counts) = render_with(scene, &octree, w, h, |s| s.samples = 1);
+    (img, counts.nonfinite_samples)
+}
+
+/// Scaled by 1e-4 and 1e4 and moved 1e5 and 1e6 from the origin, scenes
+/// render like the unit-scale original: at most 0.25% of pixels may differ
+/// by more than 2/255 (silhouette pixels whose centre ray lands within
+/// rounding of an edge), and none may be NaN.
+#[test]
+fn scenes_render_alike_at_any_scale_and_distance_from_the_origin() {
+    for name in [
+        "scenes/glass.toml",
+        "scenes/quadrics.toml",
+        "scenes/triangle.toml",
+        "scenes/default.toml",
+    ] {
+        let scene = load(name);
+        let (w, h) = (96, 72);
+        let (base, nonfinite) = render_scene(&scene, w, h);
+        assert_eq!(nonfinite, 0);
+        for (s, t) in [
+            (1e-4, DVec3::ZERO),
+            (1e4, DVec3::ZERO),
+            (1.0, DVec3::new(1e5, -1e5, 1e5)),
+            (1.0, DVec3::new(1e6, 1e6, -1e6)),
+        ] {
+            let (img, nonfinite) = render_scene(&transformed(&scene, s, t), w, h);
+            let (differing, largest) = diff(&base, &img, 2);
+            let limit = (w * h) as usize / 400;
+            eprintln!(
+                "{name} scaled {s:e}, moved {t}: {differing} of {} pixels differ by > 2/255 (largest {largest})",
+                w * h
+            );
+            assert_eq!(nonfinite, 0, "{name} scaled {s} moved {t}: NaN samples");
+            assert!(
+                differing <= limit,
+                "{name} scaled {s}, moved {t}: {differing} of {} pixels differ by more than 2/255 (largest {largest}), limit {limit}",
+                w * h
+            );
+        }
+    }
+}
+
+#[test]
+fn closed_mesh_is_watertight_from_inside() {
+    // An octahedron: rays from its centre through every vertex, every edge
+    // midpoint and points along the edges must hit one of its faces.
+    let v = [
+        DVec3::X,
+        -DVec3::X,
+        DVec3::Y,
+        -DVec3::Y,
+        DVec3::Z,
+        -DVec3::Z,
+    ]
+    .map(|p| p * 0.7 + DVec3::splat(0.1));
+    let faces = [
+        [0, 2, 4],
+        [2, 1, 4],
+        [1, 3, 4],
+        [3, 0, 4],
+        [2, 0, 5],
+        [1, 2, 5],
+        [3, 1, 5],
+        [0, 3, 5],
+    ];
+    let shapes: Vec<Shape> = faces
+        .iter()
+        .map(|f| Shape::Triangle(Triangle::new([v[f[0]], v[f[1]], v[f[2]]]).unwrap()))
+        .collect();
+    let centre = DVec3::splat(0.1);
+    let mut targets: Vec<DVec3> = v.to_vec();
+    for f in faces {
+        for k in 0..3 {
+            let (a, b) = (v[f[k]], v[f[(k + 1) % 3]]);
+            for step in 1..20 {
+                targets.push(a.lerp(b, step as f64 / 20.0));
+            }
+        }
+    }
+    let octree = Octree::build(&shapes, Default::default());
+    let mut misses = 0;
+    for target in &targets {
+        let ray = PreparedRay::new(Ray::new(centre, (*target - centre).normalize()));
+        let brute = glint::accel::closest_brute_force(
+            &shapes,
+            &ray,
+            f64::INFINITY,
+            &mut glint::stats::NoCounts,
+        );
+        let tree = octree.closest(&shapes, &ray, f64::INFINITY, &mut glint::stats::NoCounts);
+        assert_eq!(brute, tree);
+        if brute.is_none() {
+            misses += 1;
+        }
+    }
+    assert_eq!(
+        misses,
+        0,
+        "{misses} of {} rays through edges and vertices escaped",
+        targets.len()
+    );
+}
+
+#[test]
+fn tiny_and_huge_triangles_hit_where_expected() {
+    for size in [1e-4, 1.0, 1e4] {
+        let tri = Triangle::new([DVec3::ZERO, DVec3::X * size, DVec3::Y * size]).unwrap();
+        let ray = PreparedRay::new(Ray::new(
+            DVec3::new(0.25 * size, 0.25 * size, size),
+            -DVec3::Z,
+        ));
+        let hit = tri.intersect(&ray, f64::INFINITY).expect("hit");
+        assert!(
+            (hit.t - size).abs() <= 1e-12 * size,
+            "size {size}: t = {}",
+            hit.t
+        );
+    }
+}
+
+#[test]
+fn quadric_extremes() {
+    // Tiny sphere seen from far away, in quadric form.
+    let r = 1e-3;
+    let c = DVec3::new(0.0, 0.0, -1e4);
+    let q = Quadric::new(
+        [
+            1.0,
+            0.0,
+            0.0,
+            0.0,
+            1.0,
+            0.0,
+            0.0,
+            1.0,
+            -2.0 * c.z,
+            c.z * c.z - r * r,
+        ],
+        None,
+    );
+    let ray = Ray::new(DVec3::ZERO, -DVec3::Z);
+    let hit = q
+        .intersect(&ray, f64::INFINITY)
+        .expect("hits the tiny sphere");
+    assert!((hit.t - (1e4 - r)).abs() < 1e-6, "t = {}", hit.t);
+    // Origin on the surface (Cq = 0): leaving the surface outward finds nothing,
+    // going inward finds the far side.
+    let unit = Quadric::new([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, -1.0], None);
+    let on = DVec3::X;
+    assert!(
+        unit.intersect(&Ray::new(on, DVec3::X), f64::INFINITY)
+            .is_none()
+    );
+    let inward = unit
+        .intersect(&Ray::new(on, -DVec3::X), f64::INFINITY)
+        .expect("far side");
+    assert!((inward.t - 2.0).abs() < 1e-12);
+    // A tangent ray grazes at exactly one point and yields a finite normal.
+    let tangent = Ray::new(DVec3::new(-5.0, 1.0, 0.0), DVec3::X);
+    if let Some(h) = unit.intersect(&tangent, f64::INFINITY) {
+        assert!(unit.surface(&tangent, &h).geometric_normal.is_finite());
+    }
+}
+
+#[test]
+fn total_internal_reflection_at_great_depth_stays_finite() {
+    let mut scene = load("scenes/glass.toml");
+    scene.image.max_depth = 64;
+    let octree = Octree::build(&scene.shapes, scene.octree_params);
+    let (_, counts) = render_with(&scene, &octree, 48, 36, |s| s.samples = 1);
+    assert_eq!(counts.nonfinite_samples, 0);
+    assert!(counts.rays.refraction > 0 && counts.rays.reflection > 0);
+}
+
+#[test]
+fn extreme_cameras_give_images_or_clear_errors() {
+    let scene = load("scenes/sphere.toml");
+    let octree = Octree::build(&scene.shapes, scene.octree_params);
+    for fov in [0.01, 179.0] {
+        let mut s = scene.clone();
+        s.camera.fov = fov;
+        let (img, counts) = render_with(&s, &octree, 32, 24, |r| r.samples = 1);
+        assert_eq!(counts.nonfinite_samples, 0, "fov {fov}");
+        assert_eq!(img.len(), 32 * 24 * 3);
+    }
+    // fov 0.01 looks at the sphere's centre: every pixel is the sphere.
+    let mut narrow = scene.clone();
+    narrow.camera.fov = 0.01;
+    let (_, c) = render_with(&narrow, &octree, 8, 8, |r| r.samples = 1);
+    assert_eq!(c.rays.primary_hits, 64);
+    // Up almost parallel to the view direction still forms a valid basis...
+    let mut tilted = scene.clone();
+    let view = (scene.camera.lookat - scene.camera.eye).normalize();
+    tilted.camera.up = (view + DVec3::new(1e-6, 0.0, 0.0)).normalize();
+    assert!(Camera::new(&tilted.camera, 16, 16).is_ok());
+    // ...exactly parallel is a clear error.
+    tilted.camera.up = view;
+    let err = Renderer::new(&tilted, &octree, RenderSettings::from_scene(&tilted))
+        .err()
+        .expect("an error");
+    assert!(err.to_string().contains("parallel"), "{err}");
+    // 1x1 and 1x10000 images.
+    for (w, h) in [(1, 1), (1, 10_000), (10_000, 1)] {
+        let (img, counts) = render_with(&scene, &octree, w, h, |r| r.samples = 16);
+        assert_eq!(img.len(), (w * h * 3) as usize);
+        assert_eq!(counts.nonfinite_samples, 0);
+    }
+    let zero = Camera::new(
+        &CameraSpec {
+            fov: 40.0,
+            ..scene.camera
+        },
+        0,
+        10,
+    );
+    assert!(zero.is_err());
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 300, ..ProptestConfig::default() })]
+
+    /// Arbitrary text never panics either parser.
+    #[test]
+    fn parsers_never_panic_on_arbitrary_text(text in ".{0,400}") {
+        for ext in ["toml", "nff"] {
+            let path = std::path::PathBuf::from(format!("fuzz.{ext}"));
+            let _ = glint::scene::load_str(&text, &path, &glint::scene::FileSystem);
+        }
+    }
+
+    /// Mutations of real scene files (a byte range replaced by tokens the
+    /// parsers find hard) give a scene or an error, never a panic.
+    #[test]
+    fn parsers_never_panic_on_mutated_scenes(
+        which in 0usize..2,
+        start in 0usize..4000,
+        len in 0usize..40,
+        insert in prop::sample::select(vec!["", "nan", "inf", "-1", "1e308", "99999999999999999999", "[", "]", "{", "=", "\"", "p 4000000000", "s", "v\n", "0 0 0", "\n[[objects]]\n", "#", "\u{0}", "é"]),
+    ) {
+        let (name, ext) = [("scenes/glass.toml", "toml"), ("scenes/spd/tetra.nff", "nff")][which];
+        let original = std::fs::read_to_string(common::repo_path(name)).unwrap();
+        let original = &original[..original.len().min(6000)];
+        let start = original.floor_char_boundary(start.min(original.len()));
+        let end = original.floor_char_boundary((start + len).min(original.len()));
+        let mutated = format!("{}{}{}", &original[..start], insert, &original[end..]);
+        let path = common::repo_path(name).with_extension(ext);
+        let _ = glint::scene::load_str(&mutated, &path, &glint::scene::FileSystem);
+    }
+}
+
+#[test]
+fn malformed_inputs_are_clear_errors() {
+    let dir = std::env::temp_dir().join(format!("glint-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cases: &[(&str, &[u8], &str)] = &[
+        ("missing.toml", b"", "cannot read scene file"),
+        ("binary.toml", b"\xff\xfe\x00camera", "is not UTF-8"),
+        ("huge.nff", b"v\nfrom 0 0 1\nat 0 0 0\nup 0 1 0\nangle 40\nhither 1\nresolution 99999999 10\n", "resolution must be a whole number"),
+        ("neg.nff", b"v\nfrom 0 0 1\nat 0 0 0\nup 0 1 0\nangle 40\nhither 1\nresolution 10 10\nf 1 1 1 1 0 0 0 1\ns 0 0 0 -0\n", "radius must not be zero"),
+        ("empty.toml", b"", "missing field `camera`"),
+        ("scene.txt", b"", "unknown scene format"),
+    ];
+    for (file, bytes, expected) in cases {
+        let path = dir.join(file);
+        if *file != "missing.toml" {
+            std::fs::write(&path, bytes).unwrap();
+        }
+        let err = glint::scene::load(&path)
+            .err()
+            .unwrap_or_else(|| panic!("{file} should fail"))
+            .to_string();
+        assert!(err.contains(expected), "{file}: {err}");
+        assert!(
+            err.contains(file),
+            "{file}: the message names the file: {err}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
