@@ -20,7 +20,8 @@ pub enum ViewMode {
     Shaded,
     /// Geometric normal facing the camera as `(n + 1) / 2`, not sRGB encoded.
     Normals,
-    /// Distance along the eye ray, nearest visible point white, farthest black.
+    /// Distance along the eye ray as `nearest / distance`: the nearest
+    /// visible point white, falling off towards black at the horizon.
     Depth,
 }
 
@@ -505,6 +506,30 @@ impl<'a> Renderer<'a> {
     }
 }
 
+/// The nearest visible distance among depth-view pixels (0 if none hit).
+pub fn nearest_depth(pixels: &[DVec3]) -> f64 {
+    pixels
+        .iter()
+        .filter(|p| p.y > 0.0)
+        .map(|p| p.x)
+        .fold(f64::INFINITY, f64::min)
+        .min(f64::MAX)
+        .max(0.0)
+}
+
+/// Grey level of a depth-view pixel: `near / distance`, so the nearest
+/// visible point is white and the shade falls off with distance towards
+/// black at the horizon. (A linear ramp to the farthest point fails on
+/// infinite planes, whose far end is at the horizon and would wash out
+/// everything else.) Misses are black; partly covered pixels fade.
+pub fn depth_shade(p: DVec3, near: f64) -> f64 {
+    if p.y <= 0.0 || !(p.x > 0.0) {
+        0.0
+    } else {
+        (near / p.x).clamp(0.0, 1.0) * p.y
+    }
+}
+
 /// sRGB transfer function (IEC 61966-2-1) of a linear value in `[0, 1]`.
 pub fn linear_to_srgb(x: f64) -> f64 {
     let x = x.clamp(0.0, 1.0);
@@ -536,21 +561,9 @@ impl Frame {
                 }
             }
             ViewMode::Depth => {
-                let hits = self.pixels.iter().filter(|p| p.y > 0.0);
-                let (near, far) = hits.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-                    (lo.min(p.x), hi.max(p.x))
-                });
-                let range = far - near;
+                let near = nearest_depth(&self.pixels);
                 for p in &self.pixels {
-                    let v = if p.y <= 0.0 {
-                        0.0
-                    } else if range > 0.0 {
-                        // Pixels partly covered fade towards the black background.
-                        (1.0 - (p.x - near) / range) * p.y
-                    } else {
-                        p.y
-                    };
-                    out.extend([to_byte(v); 3]);
+                    out.extend([to_byte(depth_shade(*p, near)); 3]);
                 }
             }
         }

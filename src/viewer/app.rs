@@ -55,6 +55,8 @@ pub struct ViewerOptions {
     pub view: Option<ViewMode>,
     pub octree: Option<bool>,
     pub anti_aliasing: Option<bool>,
+    /// Image size overriding the scene's.
+    pub size: Option<(u32, u32)>,
 }
 
 /// A message shown in the status area.
@@ -126,6 +128,9 @@ impl GlintApp {
         }
         if let Some(o) = options.octree {
             settings.use_octree = o;
+        }
+        if let Some((w, h)) = options.size {
+            (settings.width, settings.height) = (w, h);
         }
         let (octree, build_seconds) = build_octree(&scene);
         Ok(Self {

@@ -102,8 +102,10 @@ struct Shared {
 
 /// Tiles arrive far faster than a screen refreshes; asking for a repaint
 /// per tile would make the UI thread (and a software OpenGL under Xvfb)
-/// compete with the renderer for the cores. 30 repaints a second suffice.
-const REPAINT_INTERVAL: Duration = Duration::from_millis(33);
+/// compete with the renderer for the cores: under Xvfb's software OpenGL a
+/// repaint of the full window costs tens of milliseconds of CPU. Ten
+/// repaints a second show the sweep and leave the cores to the renderer.
+const REPAINT_INTERVAL: Duration = Duration::from_millis(100);
 
 impl Shared {
     fn repaint_soon(&self) {
@@ -400,32 +402,22 @@ fn count_tile(shared: &Shared, generation: u64) {
     }
 }
 
-/// Display bytes of one tile. Depth is normalised by the range seen so far
-/// (the finished pass replaces it with the exact full-frame normalisation).
+/// Display bytes of one tile. Depth is normalised by the nearest distance
+/// seen so far; the finished pass replaces it with the exact full frame.
 fn tile_rgba(values: &[DVec3], view: ViewMode, depth_range: &Mutex<(f64, f64)>) -> Vec<u8> {
     let rgb = match view {
         ViewMode::Depth => {
-            let (near, far) = {
+            let near = {
                 let mut r = depth_range.lock().unwrap_or_else(|e| e.into_inner());
-                for v in values.iter().filter(|v| v.y > 0.0) {
-                    r.0 = r.0.min(v.x);
-                    r.1 = r.1.max(v.x);
+                if values.iter().any(|v| v.y > 0.0) {
+                    r.0 = r.0.min(crate::render::nearest_depth(values));
                 }
-                *r
+                r.0
             };
-            let mut frame = Frame {
-                width: values.len() as u32,
-                height: 1,
-                view,
-                pixels: values.to_vec(),
-            };
-            // Two sentinel pixels pin the normalisation to the running range.
-            frame.pixels.push(DVec3::new(near, 1.0, 0.0));
-            frame.pixels.push(DVec3::new(far, 1.0, 0.0));
-            frame.width += 2;
-            let mut bytes = frame.to_rgb8();
-            bytes.truncate(values.len() * 3);
-            bytes
+            values
+                .iter()
+                .flat_map(|v| [(crate::render::depth_shade(*v, near) * 255.0).round() as u8; 3])
+                .collect()
         }
         _ => Frame {
             width: values.len() as u32,

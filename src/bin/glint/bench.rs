@@ -8,7 +8,9 @@ use glint::accel::{Octree, OctreeStats};
 use glint::render::{RenderSettings, Renderer, TileCounts};
 use serde::Serialize;
 
-use crate::common::{OctreeArgs, load_scene, parse_positive, parse_samples, thread_pool};
+use crate::common::{
+    OctreeArgs, load_scene, parse_positive, parse_samples, parse_size, thread_pool,
+};
 
 #[derive(clap::Args)]
 pub struct BenchArgs {
@@ -57,13 +59,6 @@ pub struct BenchArgs {
 pub enum Format {
     Json,
     Markdown,
-}
-
-fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("expected WIDTHxHEIGHT, got `{s}`"))?;
-    Ok((parse_positive(w)?, parse_positive(h)?))
 }
 
 /// One configuration's medians.

@@ -42,6 +42,14 @@ pub fn parse_samples(s: &str) -> std::result::Result<u32, String> {
     }
 }
 
+/// `WIDTHxHEIGHT`, both at least 1.
+pub fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT, got `{s}`"))?;
+    Ok((parse_positive(w)?, parse_positive(h)?))
+}
+
 pub fn parse_positive(s: &str) -> std::result::Result<u32, String> {
     match s.parse::<u32>() {
         Ok(n) if n > 0 => Ok(n),

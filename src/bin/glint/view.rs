@@ -6,7 +6,7 @@ use anyhow::{Result, anyhow};
 use glint::render::ViewMode;
 use glint::viewer::{GlintApp, SceneSource, ViewerOptions};
 
-use crate::common::Switch;
+use crate::common::{Switch, parse_size};
 
 #[derive(clap::Args)]
 pub struct ViewArgs {
@@ -28,6 +28,9 @@ pub struct ViewArgs {
     /// Start with anti-aliasing on or off (default: on if the scene asks for 16 samples).
     #[arg(long, value_enum)]
     pub aa: Option<Switch>,
+    /// Image size as WIDTHxHEIGHT (default: the scene's).
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
     /// Render threads (default: one per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
@@ -47,6 +50,7 @@ impl Default for ViewArgs {
             octree: None,
             aa: None,
             threads: 0,
+            size: None,
             window: "1400x860".into(),
         }
     }
@@ -71,6 +75,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         view: args.view,
         octree: args.octree.map(Switch::is_on),
         anti_aliasing: args.aa.map(Switch::is_on),
+        size: args.size,
     };
     let native = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
