@@ -530,6 +530,57 @@ pub fn depth_shade(p: DVec3, near: f64) -> f64 {
     }
 }
 
+/// Root-mean-square error and PSNR of `a` against `reference`, in linear
+/// light and after sRGB encoding (both on [0, 1], channels clamped).
+#[derive(Clone, Copy, Debug)]
+pub struct ImageError {
+    pub rmse_linear: f64,
+    pub psnr_linear: f64,
+    pub rmse_srgb: f64,
+    pub psnr_srgb: f64,
+    /// Fraction of pixels differing by more than 1/255 in sRGB.
+    pub visible_fraction: f64,
+}
+
+pub fn image_error(a: &[DVec3], reference: &[DVec3]) -> ImageError {
+    let (mut lin, mut srgb, mut visible) = (0.0, 0.0, 0usize);
+    for (p, q) in a.iter().zip(reference) {
+        let (p, q) = (
+            p.clamp(DVec3::ZERO, DVec3::ONE),
+            q.clamp(DVec3::ZERO, DVec3::ONE),
+        );
+        lin += (p - q).length_squared();
+        let enc = |v: DVec3| {
+            DVec3::new(
+                linear_to_srgb(v.x),
+                linear_to_srgb(v.y),
+                linear_to_srgb(v.z),
+            )
+        };
+        let d = enc(p) - enc(q);
+        srgb += d.length_squared();
+        if d.abs().max_element() > 1.0 / 255.0 {
+            visible += 1;
+        }
+    }
+    let n = (a.len() * 3).max(1) as f64;
+    let (rl, rs) = ((lin / n).sqrt(), (srgb / n).sqrt());
+    let psnr = |r: f64| {
+        if r > 0.0 {
+            -20.0 * r.log10()
+        } else {
+            f64::INFINITY
+        }
+    };
+    ImageError {
+        rmse_linear: rl,
+        psnr_linear: psnr(rl),
+        rmse_srgb: rs,
+        psnr_srgb: psnr(rs),
+        visible_fraction: visible as f64 / a.len().max(1) as f64,
+    }
+}
+
 /// sRGB transfer function (IEC 61966-2-1) of a linear value in `[0, 1]`.
 pub fn linear_to_srgb(x: f64) -> f64 {
     let x = x.clamp(0.0, 1.0);

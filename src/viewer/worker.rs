@@ -66,6 +66,9 @@ pub struct PassRecord {
     pub height: u32,
     /// Seconds since the worker started, when the pass finished.
     pub finished_at: f64,
+    /// For a 16-sample pass: the error of the same generation's 1-sample
+    /// pass against it (what anti-aliasing changed).
+    pub one_sample_error: Option<crate::render::ImageError>,
 }
 
 /// The display buffer: RGBA8, exactly what the viewer shows and exports.
@@ -88,6 +91,10 @@ pub struct DisplayBuffer {
     pub last_frame: Option<Frame>,
 }
 
+/// The 1-sample frame of the generation being refined, kept by the worker
+/// to measure what the 16-sample pass changes.
+type OneSampleFrame = Mutex<Option<(u64, Frame)>>;
+
 struct Shared {
     generation: AtomicU64,
     buffer: Mutex<DisplayBuffer>,
@@ -98,6 +105,7 @@ struct Shared {
     tiles_started: Mutex<Vec<(u64, u64)>>,
     /// When the UI was last asked to repaint for new tiles.
     last_repaint: Mutex<Instant>,
+    one_sample: OneSampleFrame,
 }
 
 /// Tiles arrive far faster than a screen refreshes; asking for a repaint
@@ -137,6 +145,7 @@ impl Worker {
             started: Instant::now(),
             tiles_started: Mutex::new(Vec::new()),
             last_repaint: Mutex::new(Instant::now()),
+            one_sample: Mutex::new(None),
         });
         let (tx, rx) = channel();
         let thread_shared = Arc::clone(&shared);
@@ -358,6 +367,20 @@ fn render_pass(
         pixels,
     };
     let rgba = rgb_to_rgba(&frame.to_rgb8());
+    let one_sample_error = {
+        let mut one = shared.one_sample.lock().unwrap_or_else(|e| e.into_inner());
+        match kind {
+            PassKind::OneSample => {
+                *one = Some((generation, frame.clone()));
+                None
+            }
+            PassKind::SixteenSamples => one
+                .as_ref()
+                .filter(|(g, f)| *g == generation && f.pixels.len() == frame.pixels.len())
+                .map(|(_, f)| crate::render::image_error(&f.pixels, &frame.pixels)),
+            PassKind::Preview { .. } => None,
+        }
+    };
     {
         let mut b = shared.buffer.lock().unwrap_or_else(|e| e.into_inner());
         if b.generation != generation {
@@ -379,6 +402,7 @@ fn render_pass(
             width: w,
             height: h,
             finished_at: shared.started.elapsed().as_secs_f64(),
+            one_sample_error,
         });
     }
     (shared.repaint)();

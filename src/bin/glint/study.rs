@@ -12,7 +12,7 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use glint::accel::{Octree, OctreeParams};
 use glint::math::DVec3;
-use glint::render::{Frame, RenderSettings, Renderer, linear_to_srgb};
+use glint::render::{Frame, RenderSettings, Renderer, image_error, linear_to_srgb};
 use glint::scene::Scene;
 
 use crate::common::{load_scene, parse_positive, thread_pool};
@@ -36,57 +36,6 @@ pub struct StudyArgs {
     pub threads: usize,
 }
 
-/// Root-mean-square error and PSNR of `a` against `reference`, in linear
-/// light and after sRGB encoding (both on [0, 1], channels clamped).
-#[derive(Clone, Copy, Debug)]
-pub struct ImageError {
-    pub rmse_linear: f64,
-    pub psnr_linear: f64,
-    pub rmse_srgb: f64,
-    pub psnr_srgb: f64,
-    /// Fraction of pixels differing by more than 1/255 in sRGB.
-    pub visible_fraction: f64,
-}
-
-pub fn image_error(a: &[DVec3], reference: &[DVec3]) -> ImageError {
-    let (mut lin, mut srgb, mut visible) = (0.0, 0.0, 0usize);
-    for (p, q) in a.iter().zip(reference) {
-        let (p, q) = (
-            p.clamp(DVec3::ZERO, DVec3::ONE),
-            q.clamp(DVec3::ZERO, DVec3::ONE),
-        );
-        lin += (p - q).length_squared();
-        let enc = |v: DVec3| {
-            DVec3::new(
-                linear_to_srgb(v.x),
-                linear_to_srgb(v.y),
-                linear_to_srgb(v.z),
-            )
-        };
-        let d = enc(p) - enc(q);
-        srgb += d.length_squared();
-        if d.abs().max_element() > 1.0 / 255.0 {
-            visible += 1;
-        }
-    }
-    let n = (a.len() * 3).max(1) as f64;
-    let (rl, rs) = ((lin / n).sqrt(), (srgb / n).sqrt());
-    let psnr = |r: f64| {
-        if r > 0.0 {
-            -20.0 * r.log10()
-        } else {
-            f64::INFINITY
-        }
-    };
-    ImageError {
-        rmse_linear: rl,
-        psnr_linear: psnr(rl),
-        rmse_srgb: rs,
-        psnr_srgb: psnr(rs),
-        visible_fraction: visible as f64 / a.len().max(1) as f64,
-    }
-}
-
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
@@ -103,11 +52,25 @@ struct Study<'a> {
 impl Study<'_> {
     /// Median time and the frame of a render with `settings`.
     fn run(&self, settings: RenderSettings, octree: Option<&Octree>) -> Result<(f64, Frame)> {
+        self.run_times(settings, octree, self.repeat)
+    }
+
+    /// An untimed reference image: rendered once.
+    fn reference(&self, settings: RenderSettings) -> Result<Frame> {
+        Ok(self.run_times(settings, None, 1)?.1)
+    }
+
+    fn run_times(
+        &self,
+        settings: RenderSettings,
+        octree: Option<&Octree>,
+        repeat: u32,
+    ) -> Result<(f64, Frame)> {
         let octree = octree.unwrap_or(&self.octree);
         let renderer = Renderer::new(self.scene, octree, settings)?;
         let mut times = Vec::new();
         let mut frame = None;
-        for _ in 0..self.repeat {
+        for _ in 0..repeat.max(1) {
             let start = Instant::now();
             let (f, _) = self.pool.install(|| renderer.render(false, None));
             times.push(start.elapsed().as_secs_f64());
@@ -206,13 +169,10 @@ pub fn run(args: &StudyArgs) -> Result<()> {
         writeln!(md, "## {}\n", path.display())?;
 
         // Anti-aliasing.
-        let (_, reference) = study.run(
-            RenderSettings {
-                samples: 256,
-                ..base
-            },
-            None,
-        )?;
+        let reference = study.reference(RenderSettings {
+            samples: 256,
+            ..base
+        })?;
         writeln!(
             md,
             "### Anti-aliasing (reference: 256 samples, 16x16 grid)\n"
@@ -268,14 +228,11 @@ pub fn run(args: &StudyArgs) -> Result<()> {
         )?;
 
         // Recursion depth.
-        let (_, deep) = study.run(
-            RenderSettings {
-                max_depth: 12,
-                samples: 1,
-                ..base
-            },
-            None,
-        )?;
+        let deep = study.reference(RenderSettings {
+            max_depth: 12,
+            samples: 1,
+            ..base
+        })?;
         writeln!(md, "### Recursion depth (reference: depth 12, 1 sample)\n")?;
         writeln!(
             md,
