@@ -208,6 +208,16 @@ pub fn timing_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                     "16 / 1 time ratio",
                     format!("{:.1}x", b.seconds / a.seconds.max(1e-9)),
                 );
+                if let Some(e) = b.one_sample_error {
+                    row(
+                        "1-sample error vs 16",
+                        format!("RMSE {:.4}, PSNR {:.1} dB (sRGB)", e.rmse_srgb, e.psnr_srgb),
+                    );
+                    row(
+                        "pixels AA changes",
+                        format!("{:.1}% (> 1/255)", 100.0 * e.visible_fraction),
+                    );
+                }
             }
             if let Some(r) = history.last() {
                 row(

@@ -208,7 +208,6 @@ pub fn run(args: &StudyArgs) -> Result<()> {
                     let need = args.out.join(format!("{stem}-aa-need.png"));
                     save_difference(&one.pixels, &f.pixels, w, h, 4.0, &need)?;
                     let e = image_error(&one.pixels, &f.pixels);
-                    writeln!(md, "\n")?;
                     summary.push((
                         stem.clone(),
                         "1 vs 16 samples: pixels anti-aliasing changes".to_string(),
