@@ -15,10 +15,14 @@
 
 pub mod accel;
 pub mod camera;
+pub mod export;
+pub mod legend;
 pub mod material;
 pub mod math;
+pub mod ray_tree;
 pub mod render;
 pub mod scene;
+pub mod sha256;
 pub mod shapes;
 pub mod stats;
 #[cfg(feature = "gui")]

@@ -7,13 +7,14 @@ use rayon::prelude::*;
 use crate::accel::{ClosestHit, Occlusion, Octree, closest_brute_force, occlusion_brute_force};
 use crate::camera::{Camera, CameraError, CameraSpec, sample_offsets};
 use crate::math::{Color, DVec3, Ray, offset_ray_origin, reflect, refract};
+use crate::ray_tree::{HitRecord, NoRecord, RayKind, RayNode, RayRecorder, ShadowRecord};
 use crate::scene::Scene;
 use crate::shapes::PreparedRay;
 use crate::stats::{Counter, NoCounts, RayCounts, WorkCounts};
 
 /// What the image shows.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum ViewMode {
     /// Whitted shading (sRGB encoded on output).
     #[default]
@@ -23,33 +24,68 @@ pub enum ViewMode {
     /// Distance along the eye ray as `nearest / distance`: the nearest
     /// visible point white, falling off towards black at the horizon.
     Depth,
+    /// Intersection tests summed over every ray a pixel spawned (eye,
+    /// shadow, reflection, refraction), on the viridis colour map.
+    Cost,
+    /// Like [`ViewMode::Cost`], counting octree traversal steps.
+    CostSteps,
+    /// |1 sample − 16 samples| per pixel in sRGB, gain 4: where
+    /// anti-aliasing changes the picture. Built from two shaded renders.
+    AaNeed,
 }
 
 impl ViewMode {
-    pub const ALL: [ViewMode; 3] = [ViewMode::Shaded, ViewMode::Normals, ViewMode::Depth];
+    pub const ALL: [ViewMode; 6] = [
+        ViewMode::Shaded,
+        ViewMode::Normals,
+        ViewMode::Depth,
+        ViewMode::Cost,
+        ViewMode::CostSteps,
+        ViewMode::AaNeed,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
             ViewMode::Shaded => "shaded",
             ViewMode::Normals => "normals",
             ViewMode::Depth => "depth",
+            ViewMode::Cost => "cost",
+            ViewMode::CostSteps => "cost-steps",
+            ViewMode::AaNeed => "aa-need",
         }
+    }
+
+    /// Whether pixels count the work of their rays.
+    pub fn is_cost(self) -> bool {
+        matches!(self, ViewMode::Cost | ViewMode::CostSteps)
+    }
+
+    /// Whether each eye ray is shaded (the full Whitted recursion runs).
+    fn traces_shading(self) -> bool {
+        matches!(
+            self,
+            ViewMode::Shaded | ViewMode::Cost | ViewMode::CostSteps | ViewMode::AaNeed
+        )
     }
 }
 
 impl std::str::FromStr for ViewMode {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        Self::ALL
-            .into_iter()
-            .find(|v| v.name() == s)
-            .ok_or_else(|| format!("unknown view `{s}` (expected shaded, normals or depth)"))
+        Self::ALL.into_iter().find(|v| v.name() == s).ok_or_else(|| {
+            format!(
+                "unknown view `{s}` (expected shaded, normals, depth, cost, cost-steps or aa-need)"
+            )
+        })
     }
 }
 
+/// Gain of the aa-need view: a difference of 1/4 shows at full brightness.
+pub const AA_NEED_GAIN: f64 = 4.0;
+
 /// Everything that decides the image besides the scene; the command line
 /// and the viewer override the scene's own values.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RenderSettings {
     pub width: u32,
     pub height: u32,
@@ -86,7 +122,10 @@ pub enum RenderError {
 
 /// A rendered image: linear RGB for [`ViewMode::Shaded`] and
 /// [`ViewMode::Normals`]; for [`ViewMode::Depth`] the mean distance in `x`
-/// and the fraction of samples that hit in `y`.
+/// and the fraction of samples that hit in `y`; for the cost views the
+/// pixel's intersection tests, traversal steps and leaves visited in `x`,
+/// `y`, `z` (summed over its samples and every ray they spawned); for
+/// [`ViewMode::AaNeed`] the absolute sRGB difference per channel.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Frame {
     pub width: u32,
@@ -256,16 +295,20 @@ impl<'a> Renderer<'a> {
     }
 
     /// Colour seen along `ray`, which is at recursion `depth` (eye ray = 1).
-    fn trace<C: Counter>(
+    fn trace<C: Counter, R: RayRecorder>(
         &self,
         ray: &Ray,
         depth: u32,
         counter: &mut C,
         rays: &mut RayCounts,
+        rec: &mut R,
     ) -> Color {
         let prepared = PreparedRay::new(*ray);
         let Some(hit) = self.closest(&prepared, counter) else {
-            return self.scene.image.background;
+            let background = self.scene.image.background;
+            rec.local(background);
+            rec.finish(background);
+            return background;
         };
         if depth == 1 {
             rays.primary_hits += 1;
@@ -291,32 +334,56 @@ impl<'a> Renderer<'a> {
         }
         let view = -ray.dir;
         let p = surface.point;
+        rec.hit(|| HitRecord {
+            object: hit.shape,
+            kind: shape.kind_name(),
+            material: material.name.clone(),
+            distance: hit.hit.t,
+            point: p.to_array(),
+            normal: n.to_array(),
+            entering,
+        });
 
         let mut color = material.ka * scene.image.ambient * material.color;
         let shadow_origin = offset_ray_origin(p, facing, self.floor_scale);
-        for light in &scene.lights {
+        for (index, light) in scene.lights.iter().enumerate() {
+            let verdict = |verdict, transmittance, color: Color| ShadowRecord {
+                light: index,
+                verdict,
+                transmittance,
+                color: color.to_array(),
+            };
             let to_light = light.position - shadow_origin;
             let distance = to_light.length();
             if !(distance > 0.0) {
+                rec.shadow(|| verdict("faces-away", 0.0, Color::ZERO));
                 continue;
             }
             let l = to_light / distance;
             let n_dot_l = n.dot(l);
             // A surface facing away from the light gets neither light nor a shadow ray.
             if n_dot_l <= 0.0 || facing.dot(l) <= 0.0 {
+                rec.shadow(|| verdict("faces-away", 0.0, Color::ZERO));
                 continue;
             }
             rays.shadow += 1;
             let shadow = PreparedRay::new(Ray::new(shadow_origin, l));
             let pass = self.transmittance(&shadow, distance, counter);
             if pass == 0.0 {
+                rec.shadow(|| verdict("blocked", 0.0, Color::ZERO));
                 continue;
             }
             let diffuse = material.kd * n_dot_l * material.color;
             let r = 2.0 * n_dot_l * n - l;
             let specular = material.ks * r.dot(view).max(0.0).powf(material.shininess);
-            color += (diffuse + DVec3::splat(specular)) * light.color * pass;
+            let direct = (diffuse + DVec3::splat(specular)) * light.color * pass;
+            rec.shadow(|| {
+                let name = if pass < 1.0 { "attenuated" } else { "lit" };
+                verdict(name, pass, direct)
+            });
+            color += direct;
         }
+        rec.local(color);
 
         if depth < self.settings.max_depth {
             let mut reflect_weight = material.reflectivity;
@@ -330,8 +397,13 @@ impl<'a> Renderer<'a> {
                     Some(dir) => {
                         rays.refraction += 1;
                         let origin = offset_ray_origin(p, -facing, self.floor_scale);
-                        color += material.transparency
-                            * self.trace(&Ray::new(origin, dir), depth + 1, counter, rays);
+                        let child_ray = Ray::new(origin, dir);
+                        let weight = material.transparency;
+                        let mut child =
+                            rec.child(RayKind::Refraction, &child_ray, depth + 1, weight);
+                        let seen = self.trace(&child_ray, depth + 1, counter, rays, &mut child);
+                        rec.attach(child, seen);
+                        color += weight * seen;
                     }
                     // Total internal reflection: the transmitted share is reflected.
                     None => reflect_weight += material.transparency,
@@ -346,11 +418,27 @@ impl<'a> Renderer<'a> {
                     dir = reflect(ray.dir, facing);
                 }
                 let origin = offset_ray_origin(p, facing, self.floor_scale);
-                color += reflect_weight
-                    * self.trace(&Ray::new(origin, dir.normalize()), depth + 1, counter, rays);
+                let child_ray = Ray::new(origin, dir.normalize());
+                let mut child =
+                    rec.child(RayKind::Reflection, &child_ray, depth + 1, reflect_weight);
+                let seen = self.trace(&child_ray, depth + 1, counter, rays, &mut child);
+                rec.attach(child, seen);
+                color += reflect_weight * seen;
             }
         }
+        rec.finish(color);
         color
+    }
+
+    /// The tree of rays the centre ray of pixel `(i, j)` spawns, with what
+    /// each hit and contributed. Its root colour is the pixel's value at
+    /// 1 sample per pixel in the shaded view.
+    pub fn ray_tree(&self, i: u32, j: u32) -> RayNode {
+        let ray = self.camera.ray(i, j, 0.5, 0.5);
+        let mut root = RayNode::new(RayKind::Eye, &ray, 1, 1.0);
+        let mut rays = RayCounts::default();
+        self.trace(&ray, 1, &mut NoCounts, &mut rays, &mut root);
+        root
     }
 
     /// One sample of a non-shaded view for the eye ray `ray`.
@@ -388,9 +476,21 @@ impl<'a> Renderer<'a> {
         for &(dx, dy) in &self.offsets {
             let ray = self.camera.ray(i, j, dx, dy);
             counts.rays.primary += 1;
-            let mut value = match self.settings.view {
-                ViewMode::Shaded => self.trace(&ray, 1, counter, &mut counts.rays),
-                _ => self.inspect(&ray, counter, &mut counts.rays),
+            let view = self.settings.view;
+            let mut value = if view.is_cost() {
+                // Count this pixel's work on its own, then pass it on.
+                let mut work = WorkCounts::default();
+                self.trace(&ray, 1, &mut work, &mut counts.rays, &mut NoRecord);
+                counter.add_work(&work);
+                DVec3::new(
+                    work.intersection_tests as f64,
+                    work.traversal_steps as f64,
+                    work.leaves_visited as f64,
+                )
+            } else if view.traces_shading() {
+                self.trace(&ray, 1, counter, &mut counts.rays, &mut NoRecord)
+            } else {
+                self.inspect(&ray, counter, &mut counts.rays)
             };
             if !value.is_finite() {
                 counts.nonfinite_samples += 1;
@@ -409,6 +509,7 @@ impl<'a> Renderer<'a> {
                 DVec3::new(sum.x / depth_hits, depth_hits / n, 0.0)
             }
             ViewMode::Depth => DVec3::ZERO,
+            ViewMode::Cost | ViewMode::CostSteps => sum,
             _ => sum / n,
         }
     }
@@ -506,6 +607,39 @@ impl<'a> Renderer<'a> {
     }
 }
 
+/// Renders `settings.view` seen from `camera`, including the composite
+/// aa-need view (a 1-sample and a 16-sample shaded render; their work is
+/// summed). The frame for every other view is [`Renderer::render`]'s.
+pub fn render_view(
+    scene: &Scene,
+    octree: &Octree,
+    settings: RenderSettings,
+    camera: &CameraSpec,
+    count_work: bool,
+    progress: Option<&(dyn Fn(u64, u64) + Sync)>,
+) -> Result<(Frame, TileCounts), RenderError> {
+    if settings.view != ViewMode::AaNeed {
+        let renderer = Renderer::with_camera(scene, octree, settings, camera)?;
+        return Ok(renderer.render(count_work, progress));
+    }
+    let pass = |samples| {
+        Renderer::with_camera(
+            scene,
+            octree,
+            RenderSettings {
+                samples,
+                view: ViewMode::Shaded,
+                ..settings
+            },
+            camera,
+        )
+    };
+    let (one, mut counts) = pass(1)?.render(count_work, progress);
+    let (sixteen, more) = pass(16)?.render(count_work, progress);
+    counts += more;
+    Ok((Frame::aa_need(&one, &sixteen), counts))
+}
+
 /// The nearest visible distance among depth-view pixels (0 if none hit).
 pub fn nearest_depth(pixels: &[DVec3]) -> f64 {
     pixels
@@ -527,6 +661,40 @@ pub fn depth_shade(p: DVec3, near: f64) -> f64 {
         0.0
     } else {
         (near / p.x).clamp(0.0, 1.0) * p.y
+    }
+}
+
+/// Smallest, largest and mean per-pixel cost of a cost view.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CostSummary {
+    pub min: f64,
+    pub max: f64,
+    pub mean: f64,
+}
+
+/// The count a cost-view pixel shows.
+pub fn cost_value(p: DVec3, view: ViewMode) -> f64 {
+    if view == ViewMode::CostSteps {
+        p.y
+    } else {
+        p.x
+    }
+}
+
+/// Position of `value` on the colour map for a frame whose costs span `range`.
+pub fn cost_shade(value: f64, (min, max): (f64, f64)) -> f64 {
+    if max > min {
+        (value - min) / (max - min)
+    } else {
+        0.0
+    }
+}
+
+fn format_count(v: f64) -> String {
+    if v.fract() == 0.0 && v.abs() < 1e9 {
+        format!("{v:.0}")
+    } else {
+        format!("{v:.1}")
     }
 }
 
@@ -617,24 +785,121 @@ impl Frame {
                     out.extend([to_byte(depth_shade(*p, near)); 3]);
                 }
             }
+            ViewMode::Cost | ViewMode::CostSteps => {
+                let range = self.cost_summary().map_or((0.0, 0.0), |c| (c.min, c.max));
+                for p in &self.pixels {
+                    out.extend(crate::legend::viridis(cost_shade(
+                        cost_value(*p, self.view),
+                        range,
+                    )));
+                }
+            }
+            ViewMode::AaNeed => {
+                for p in &self.pixels {
+                    out.extend([p.x, p.y, p.z].map(|c| to_byte(c * AA_NEED_GAIN)));
+                }
+            }
         }
         out
     }
 
-    /// Writes a PNG, through a temporary file renamed into place so a
-    /// failed write never leaves a truncated image behind.
-    pub fn save_png(&self, path: &std::path::Path) -> Result<(), image::ImageError> {
-        let img = image::RgbImage::from_raw(self.width, self.height, self.to_rgb8())
-            .expect("the buffer has width * height * 3 bytes");
-        let file_name = path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        let tmp = path.with_file_name(format!(".{file_name}.{}.tmp", std::process::id()));
-        img.save_with_format(&tmp, image::ImageFormat::Png)?;
-        std::fs::rename(&tmp, path).map_err(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            image::ImageError::IoError(e)
+    /// The per-pixel cost of a cost view: its smallest, largest and mean.
+    pub fn cost_summary(&self) -> Option<CostSummary> {
+        if !self.view.is_cost() || self.pixels.is_empty() {
+            return None;
+        }
+        let values = self.pixels.iter().map(|p| cost_value(*p, self.view));
+        let (mut min, mut max, mut sum) = (f64::INFINITY, 0.0f64, 0.0);
+        for v in values {
+            min = min.min(v);
+            max = max.max(v);
+            sum += v;
+        }
+        Some(CostSummary {
+            min,
+            max,
+            mean: sum / self.pixels.len() as f64,
         })
+    }
+
+    /// The 1-sample picture's difference from the 16-sample one, as the
+    /// [`ViewMode::AaNeed`] view: `|sRGB(one) − sRGB(sixteen)|` per channel.
+    pub fn aa_need(one: &Frame, sixteen: &Frame) -> Frame {
+        let enc = |v: DVec3| {
+            DVec3::new(
+                linear_to_srgb(v.x),
+                linear_to_srgb(v.y),
+                linear_to_srgb(v.z),
+            )
+        };
+        Frame {
+            width: sixteen.width,
+            height: sixteen.height,
+            view: ViewMode::AaNeed,
+            pixels: one
+                .pixels
+                .iter()
+                .zip(&sixteen.pixels)
+                .map(|(p, q)| (enc(*p) - enc(*q)).abs())
+                .collect(),
+        }
+    }
+
+    /// What the legend strip of a diagnostic view says (none for the
+    /// pictures that explain themselves).
+    pub fn legend(&self) -> Option<crate::legend::Legend> {
+        use crate::legend::{Legend, Ramp};
+        match self.view {
+            ViewMode::Cost | ViewMode::CostSteps => {
+                let c = self.cost_summary()?;
+                let what = if self.view == ViewMode::Cost {
+                    "intersection tests"
+                } else {
+                    "traversal steps"
+                };
+                Some(Legend {
+                    low: format_count(c.min),
+                    high: format_count(c.max),
+                    caption: format!("{what} per pixel, mean {}", format_count(c.mean)),
+                    ramp: Ramp::Viridis,
+                })
+            }
+            ViewMode::AaNeed => {
+                let visible = self
+                    .pixels
+                    .iter()
+                    .filter(|p| p.max_element() > 1.0 / 255.0)
+                    .count() as f64
+                    / self.pixels.len().max(1) as f64;
+                Some(Legend {
+                    low: "0".into(),
+                    high: format!("{:.2}", 1.0 / AA_NEED_GAIN),
+                    caption: format!(
+                        "|1-16 spp| x{AA_NEED_GAIN}: {:.1}% px > 1/255",
+                        100.0 * visible
+                    ),
+                    ramp: Ramp::Grey,
+                })
+            }
+            _ => None,
+        }
+    }
+
+    /// The RGB8 picture as written to PNG: [`Frame::to_rgb8`] with the
+    /// legend strip appended for the diagnostic views. Returns the height.
+    pub fn to_annotated_rgb8(&self) -> (Vec<u8>, u32) {
+        let mut rgb = self.to_rgb8();
+        let height = match self.legend() {
+            Some(legend) => {
+                crate::legend::append_legend(&mut rgb, self.width, self.height, &legend)
+            }
+            None => self.height,
+        };
+        (rgb, height)
+    }
+
+    /// Writes a PNG (without a render record; see [`crate::export`]).
+    pub fn save_png(&self, path: &std::path::Path) -> Result<(), crate::export::ExportError> {
+        crate::export::save_png(self, path, None)
     }
 }

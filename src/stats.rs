@@ -9,6 +9,9 @@ pub trait Counter {
     fn traversal_step(&mut self) {}
     #[inline(always)]
     fn leaf_visit(&mut self) {}
+    /// Adds work counted elsewhere (the cost view counts per pixel).
+    #[inline(always)]
+    fn add_work(&mut self, _work: &WorkCounts) {}
 }
 
 /// Counts nothing; the default.
@@ -39,6 +42,10 @@ impl Counter for WorkCounts {
     #[inline(always)]
     fn leaf_visit(&mut self) {
         self.leaves_visited += 1;
+    }
+    #[inline(always)]
+    fn add_work(&mut self, work: &WorkCounts) {
+        *self += *work;
     }
 }
 

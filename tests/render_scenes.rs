@@ -96,6 +96,7 @@ fn head_on_plane_matches_the_analytic_colour() {
         shape_materials: vec![],
         vertex_normals: vec![],
         dropped_triangles: 0,
+        source_text: String::new(),
     };
     scene.push(Shape::Plane(Plane::new(DVec3::ZERO, DVec3::Z)), 0);
     let octree = Octree::build(&scene.shapes, scene.octree_params);

@@ -24,7 +24,7 @@ use crate::stats::Counter;
 /// any useful resolution and keeps build recursion shallow.
 pub const MAX_OCTREE_DEPTH: u32 = 21;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct OctreeParams {
     /// Deepest level a node may have; the root is level 0.
     pub max_depth: u32,

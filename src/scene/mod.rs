@@ -1,6 +1,7 @@
 //! A scene as the renderer sees it, and the two file formats that describe it:
 //! glint's own TOML ([`toml_format`]) and Eric Haines's NFF ([`nff`]).
 
+pub mod builtin;
 mod mesh;
 pub mod nff;
 pub mod toml_format;
@@ -58,6 +59,9 @@ pub struct Scene {
     pub vertex_normals: Vec<[DVec3; 3]>,
     /// Degenerate triangles dropped while loading (they could never be hit).
     pub dropped_triangles: usize,
+    /// The text the scene was parsed from, kept for reproducible exports
+    /// (empty for scenes built in code).
+    pub source_text: String,
 }
 
 impl Scene {
@@ -160,7 +164,7 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
 /// Parses scene text; `path` names it in errors, chooses the format by its
 /// extension and anchors relative mesh paths.
 pub fn load_str(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, SceneError> {
-    match path
+    let mut scene = match path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase)
@@ -171,7 +175,9 @@ pub fn load_str(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene
         _ => Err(SceneError::UnknownFormat {
             path: path.to_owned(),
         }),
-    }
+    }?;
+    scene.source_text = text.to_owned();
+    Ok(scene)
 }
 
 pub use mesh::{FileSystem, MeshSource};

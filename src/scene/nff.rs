@@ -196,6 +196,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
         shape_materials: Vec::new(),
         vertex_normals: Vec::new(),
         dropped_triangles: 0,
+        source_text: String::new(),
     };
     let mut material: Option<u32> = None;
 

@@ -303,6 +303,7 @@ pub fn parse(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, S
         shape_materials: Vec::new(),
         vertex_normals: Vec::new(),
         dropped_triangles: 0,
+        source_text: String::new(),
     };
     for (i, obj) in file.objects.iter().enumerate() {
         add_object(&cx, &mut scene, i, obj, files)?;

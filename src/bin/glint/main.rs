@@ -3,6 +3,7 @@
 
 mod bench;
 mod common;
+mod info;
 mod render_cmd;
 mod study;
 #[cfg(feature = "gui")]
@@ -29,6 +30,8 @@ enum Command {
     Bench(bench::BenchArgs),
     /// Measure speed against accuracy: anti-aliasing, depth, octree, preview.
     Study(study::StudyArgs),
+    /// Print how a PNG that glint wrote was made (scene, settings, version).
+    Info(info::InfoArgs),
     /// Open a scene in the interactive viewer (the default command).
     #[cfg(feature = "gui")]
     View(view::ViewArgs),
@@ -40,6 +43,7 @@ fn main() -> std::process::ExitCode {
         Some(Command::Render(args)) => render_cmd::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
         Some(Command::Study(args)) => study::run(&args),
+        Some(Command::Info(args)) => info::run(&args),
         #[cfg(feature = "gui")]
         Some(Command::View(args)) => view::run(&args),
         #[cfg(feature = "gui")]

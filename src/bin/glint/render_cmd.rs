@@ -14,11 +14,12 @@ use crate::common::{OctreeArgs, Switch, load_scene, parse_positive, parse_sample
 
 #[derive(clap::Args)]
 pub struct RenderArgs {
-    /// Scene file (.toml or .nff).
-    pub scene: PathBuf,
-    /// Output PNG file.
-    #[arg(short, long)]
-    pub output: PathBuf,
+    /// Scene file (.toml or .nff); not given with --from-png.
+    #[arg(required_unless_present = "from_png", conflicts_with = "from_png")]
+    pub scene: Option<PathBuf>,
+    /// Output PNG file (not needed with --trace-pixel).
+    #[arg(short, long, required_unless_present = "trace_pixel")]
+    pub output: Option<PathBuf>,
     /// Image width in pixels (default: the scene's).
     #[arg(long, value_parser = parse_positive)]
     pub width: Option<u32>,
@@ -39,12 +40,57 @@ pub struct RenderArgs {
     /// Render threads (default: one per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
-    /// What the image shows.
-    #[arg(long, default_value = "shaded", value_parser = |s: &str| s.parse::<ViewMode>())]
-    pub view: ViewMode,
+    /// What the image shows: shaded, normals, depth, cost (intersection
+    /// tests per pixel), cost-steps (traversal steps per pixel) or aa-need
+    /// (|1 − 16 samples|). Default: shaded, or the recorded view with --from-png.
+    #[arg(long, value_parser = |s: &str| s.parse::<ViewMode>())]
+    pub view: Option<ViewMode>,
     /// Print one JSON object of statistics on stdout.
     #[arg(long)]
     pub stats: bool,
+    /// Render again the image an earlier glint PNG records (its embedded
+    /// scene text and every setting); flags given as well override them.
+    #[arg(long, value_name = "OLD.png")]
+    pub from_png: Option<PathBuf>,
+    /// Print the tree of rays that pixel X,Y's centre ray spawns as one JSON
+    /// object on stdout, and render nothing else. X counts from the left,
+    /// Y from the top, both from 0.
+    #[arg(long, value_name = "X,Y", value_parser = parse_pixel)]
+    pub trace_pixel: Option<(u32, u32)>,
+}
+
+fn parse_pixel(s: &str) -> std::result::Result<(u32, u32), String> {
+    let (x, y) = s
+        .split_once(',')
+        .ok_or_else(|| format!("expected X,Y, got `{s}`"))?;
+    let n = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("expected X,Y as whole numbers, got `{s}`"))
+    };
+    Ok((n(x)?, n(y)?))
+}
+
+/// The `--trace-pixel` object (schema in README, "A pixel's ray tree").
+#[derive(Serialize)]
+struct TraceJson<'a> {
+    scene: String,
+    pixel: [u32; 2],
+    width: u32,
+    height: u32,
+    max_depth: u32,
+    octree: bool,
+    /// The pixel's value at 1 sample (linear RGB) and as written to PNG.
+    color: [f64; 3],
+    srgb8: [u8; 3],
+    lights: Vec<LightJson>,
+    tree: &'a glint::ray_tree::RayNode,
+}
+
+#[derive(Serialize)]
+struct LightJson {
+    position: [f64; 3],
+    color: [f64; 3],
 }
 
 /// The `--stats` object. Its field names are a public interface: add
@@ -82,15 +128,44 @@ struct RaysJson {
 }
 
 pub fn run(args: &RenderArgs) -> Result<()> {
-    let (mut scene, load_s) = load_scene(&args.scene)?;
+    let load_start = Instant::now();
+    let (mut scene, scene_name, mut settings, camera) = match (&args.from_png, &args.scene) {
+        (Some(png), _) => {
+            let record = glint::export::read_record(png)?;
+            if record.glint_version != env!("CARGO_PKG_VERSION") {
+                eprintln!(
+                    "note: {} was made by glint {}, this is {}: pixels may differ",
+                    png.display(),
+                    record.glint_version,
+                    env!("CARGO_PKG_VERSION")
+                );
+            }
+            let scene = glint::export::load_recorded_scene(&record)
+                .with_context(|| format!("cannot load the scene recorded in {}", png.display()))?;
+            let settings = record.settings.render;
+            (
+                scene,
+                record.scene_path.clone(),
+                settings,
+                record.settings.camera.into(),
+            )
+        }
+        (None, Some(path)) => {
+            let (scene, _) = load_scene(path)?;
+            let settings = RenderSettings::from_scene(&scene);
+            let camera = scene.camera;
+            (scene, path.display().to_string(), settings, camera)
+        }
+        (None, None) => anyhow::bail!("give a scene file or --from-png"),
+    };
+    let load_s = load_start.elapsed().as_secs_f64();
     args.octree_params.apply(&mut scene.octree_params);
-    let mut settings = RenderSettings::from_scene(&scene);
     settings.width = args.width.unwrap_or(settings.width);
     settings.height = args.height.unwrap_or(settings.height);
     settings.samples = args.samples.unwrap_or(settings.samples);
     settings.max_depth = args.max_depth.unwrap_or(settings.max_depth);
     settings.use_octree = args.octree.map_or(settings.use_octree, Switch::is_on);
-    settings.view = args.view;
+    settings.view = args.view.unwrap_or(settings.view);
 
     let pool = thread_pool(args.threads)?;
     let threads = pool.current_num_threads();
@@ -102,8 +177,15 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     };
     let build_s = build_start.elapsed().as_secs_f64();
 
-    let renderer = Renderer::new(&scene, &octree, settings)
-        .with_context(|| format!("cannot render {}", args.scene.display()))?;
+    if let Some((x, y)) = args.trace_pixel {
+        return print_ray_tree(&scene, &scene_name, &octree, settings, &camera, x, y);
+    }
+    let Some(output) = &args.output else {
+        anyhow::bail!("give an output file with -o");
+    };
+    // Validate before starting (the aa-need view renders twice).
+    Renderer::with_camera(&scene, &octree, settings, &camera)
+        .with_context(|| format!("cannot render {scene_name}"))?;
     let bar = std::io::stderr().is_terminal().then(|| {
         let bar = indicatif::ProgressBar::new(1);
         bar.set_style(
@@ -122,14 +204,22 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
     };
     let render_start = Instant::now();
-    let (frame, counts) = pool.install(|| renderer.render(args.stats, Some(&progress)));
+    let (frame, counts) = pool.install(|| {
+        glint::render::render_view(
+            &scene,
+            &octree,
+            settings,
+            &camera,
+            args.stats,
+            Some(&progress),
+        )
+    })?;
     let render_s = render_start.elapsed().as_secs_f64();
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    frame
-        .save_png(&args.output)
-        .with_context(|| format!("cannot write {}", args.output.display()))?;
+    let record = glint::export::RenderRecord::new(&scene, &scene_name, &camera, settings);
+    glint::export::save_png(&frame, output, Some(&record))?;
 
     if scene.dropped_triangles > 0 {
         eprintln!(
@@ -147,7 +237,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             }
         };
         let stats = RenderStats {
-            scene: args.scene.display().to_string(),
+            scene: scene_name.clone(),
             width: settings.width,
             height: settings.height,
             samples: settings.samples,
@@ -173,5 +263,51 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         };
         println!("{}", serde_json::to_string_pretty(&stats)?);
     }
+    Ok(())
+}
+
+fn print_ray_tree(
+    scene: &glint::scene::Scene,
+    scene_name: &str,
+    octree: &Octree,
+    mut settings: RenderSettings,
+    camera: &glint::camera::CameraSpec,
+    x: u32,
+    y: u32,
+) -> Result<()> {
+    anyhow::ensure!(
+        x < settings.width && y < settings.height,
+        "pixel {x},{y} is outside the {}x{} image",
+        settings.width,
+        settings.height
+    );
+    settings.samples = 1;
+    settings.view = ViewMode::Shaded;
+    let renderer = Renderer::with_camera(scene, octree, settings, camera)
+        .with_context(|| format!("cannot render {scene_name}"))?;
+    let tree = renderer.ray_tree(x, y);
+    let color = glam::DVec3::from_array(tree.color);
+    let srgb8 = [color.x, color.y, color.z]
+        .map(|c| (glint::render::linear_to_srgb(c) * 255.0).round() as u8);
+    let out = TraceJson {
+        scene: scene_name.to_string(),
+        pixel: [x, y],
+        width: settings.width,
+        height: settings.height,
+        max_depth: settings.max_depth,
+        octree: settings.use_octree,
+        color: tree.color,
+        srgb8,
+        lights: scene
+            .lights
+            .iter()
+            .map(|l| LightJson {
+                position: l.position.to_array(),
+                color: l.color.to_array(),
+            })
+            .collect(),
+        tree: &tree,
+    };
+    println!("{}", serde_json::to_string_pretty(&out)?);
     Ok(())
 }

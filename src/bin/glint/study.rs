@@ -6,13 +6,13 @@
 //! Writes `DIR/study.md` and difference images `DIR/*.png`.
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
 use glint::accel::{Octree, OctreeParams};
 use glint::math::DVec3;
-use glint::render::{Frame, RenderSettings, Renderer, image_error, linear_to_srgb};
+use glint::render::{Frame, RenderSettings, Renderer, image_error};
 use glint::scene::Scene;
 
 use crate::common::{load_scene, parse_positive, thread_pool};
@@ -95,35 +95,6 @@ fn upsample(f: &Frame, width: u32, height: u32) -> Vec<DVec3> {
 }
 
 /// Writes `|a - b|` (sRGB-encoded difference, scaled by `gain`) as a PNG.
-fn save_difference(
-    a: &[DVec3],
-    b: &[DVec3],
-    width: u32,
-    height: u32,
-    gain: f64,
-    path: &Path,
-) -> Result<()> {
-    let enc = |v: DVec3| {
-        DVec3::new(
-            linear_to_srgb(v.x),
-            linear_to_srgb(v.y),
-            linear_to_srgb(v.z),
-        )
-    };
-    let bytes: Vec<u8> = a
-        .iter()
-        .zip(b)
-        .flat_map(|(p, q)| {
-            let d = (enc(*p) - enc(*q)).abs() * gain;
-            [d.x, d.y, d.z].map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8)
-        })
-        .collect();
-    image::RgbImage::from_raw(width, height, bytes)
-        .context("image size")?
-        .save(path)
-        .with_context(|| format!("cannot write {}", path.display()))
-}
-
 pub fn run(args: &StudyArgs) -> Result<()> {
     let (w, h) = args
         .size
@@ -206,7 +177,8 @@ pub fn run(args: &StudyArgs) -> Result<()> {
             } else if samples == 16 {
                 if let Some(one) = &one {
                     let need = args.out.join(format!("{stem}-aa-need.png"));
-                    save_difference(&one.pixels, &f.pixels, w, h, 4.0, &need)?;
+                    // The same picture as `glint render --view aa-need`, legend included.
+                    Frame::aa_need(one, &f).save_png(&need)?;
                     let e = image_error(&one.pixels, &f.pixels);
                     summary.push((
                         stem.clone(),

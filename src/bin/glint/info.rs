@@ -1,0 +1,93 @@
+//! `glint info`: how a PNG that glint wrote was made.
+
+use std::path::PathBuf;
+
+use std::io::Write;
+
+use anyhow::Result;
+
+#[derive(clap::Args)]
+pub struct InfoArgs {
+    /// A PNG written by glint (`glint render` or the viewer's export).
+    pub png: PathBuf,
+    /// Print the record as one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+    /// Also print the embedded scene file's full text.
+    #[arg(long)]
+    pub scene_text: bool,
+}
+
+pub fn run(args: &InfoArgs) -> Result<()> {
+    let record = glint::export::read_record(&args.png)?;
+    let mut out = std::io::stdout().lock();
+    match write_info(&mut out, args, &record) {
+        // A closed pipe (`glint info F | head`) is the reader's choice.
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        other => Ok(other?),
+    }
+}
+
+fn write_info(
+    out: &mut impl Write,
+    args: &InfoArgs,
+    record: &glint::export::RenderRecord,
+) -> std::io::Result<()> {
+    if args.json {
+        let value = serde_json::json!({
+            "glint_version": record.glint_version,
+            "scene_path": record.scene_path,
+            "scene_sha256": record.scene_sha256,
+            "settings": record.settings,
+            "scene_text": record.scene_text,
+        });
+        return writeln!(out, "{}", serde_json::to_string_pretty(&value)?);
+    }
+    let s = &record.settings;
+    let r = &s.render;
+    let v3 = |v: [f64; 3]| format!("{} {} {}", v[0], v[1], v[2]);
+    writeln!(out, "file          {}", args.png.display())?;
+    writeln!(out, "glint         {}", record.glint_version)?;
+    writeln!(out, "scene         {}", record.scene_path)?;
+    writeln!(out, "scene sha256  {}", record.scene_sha256)?;
+    writeln!(out, "size          {}x{}", r.width, r.height)?;
+    writeln!(out, "samples       {}", r.samples)?;
+    writeln!(out, "max depth     {}", r.max_depth)?;
+    writeln!(out, "view          {}", r.view.name())?;
+    writeln!(
+        out,
+        "octree        {} (max depth {}, leaf size {}, cost-driven {})",
+        if r.use_octree { "on" } else { "off" },
+        s.octree_params.max_depth,
+        s.octree_params.leaf_size,
+        s.octree_params.cost_driven
+    )?;
+    writeln!(out, "camera eye    {}", v3(s.camera.eye))?;
+    writeln!(out, "camera lookat {}", v3(s.camera.lookat))?;
+    writeln!(out, "camera up     {}", v3(s.camera.up))?;
+    writeln!(out, "camera fov    {}", s.camera.fov)?;
+    writeln!(
+        out,
+        "scene text    {} bytes, {} lines{}",
+        record.scene_text.len(),
+        record.scene_text.lines().count(),
+        if args.scene_text {
+            ""
+        } else {
+            " (--scene-text prints it)"
+        }
+    )?;
+    writeln!(
+        out,
+        "re-render     glint render --from-png {} -o NEW.png",
+        args.png.display()
+    )?;
+    if args.scene_text {
+        writeln!(out, "---")?;
+        write!(out, "{}", record.scene_text)?;
+        if !record.scene_text.ends_with('\n') {
+            writeln!(out)?;
+        }
+    }
+    Ok(())
+}

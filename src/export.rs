@@ -1,0 +1,279 @@
+//! Reproducible PNG exports: every PNG glint writes carries, in text
+//! chunks, the glint version, the scene file's SHA-256 and full text, and
+//! every setting that shaped the image, so `glint render --from-png`
+//! can render it again and `glint info` can say how it was made.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::accel::OctreeParams;
+use crate::camera::CameraSpec;
+use crate::math::DVec3;
+use crate::render::{Frame, RenderSettings};
+use crate::scene::Scene;
+
+/// Text-chunk keywords. Part of the file format: never rename them.
+pub const KEY_VERSION: &str = "glint:version";
+pub const KEY_SCENE_PATH: &str = "glint:scene-path";
+pub const KEY_SCENE_SHA256: &str = "glint:scene-sha256";
+pub const KEY_SCENE: &str = "glint:scene";
+pub const KEY_SETTINGS: &str = "glint:settings";
+
+/// How an image was made: enough to make it again.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderRecord {
+    pub glint_version: String,
+    /// The scene file as it was named when loaded (anchors relative mesh paths).
+    pub scene_path: String,
+    pub scene_sha256: String,
+    pub scene_text: String,
+    pub settings: RecordedSettings,
+}
+
+/// The settings part of a record, stored as JSON.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RecordedSettings {
+    pub camera: RecordedCamera,
+    #[serde(flatten)]
+    pub render: RenderSettings,
+    pub octree_params: OctreeParams,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RecordedCamera {
+    pub eye: [f64; 3],
+    pub lookat: [f64; 3],
+    pub up: [f64; 3],
+    pub fov: f64,
+}
+
+impl From<&CameraSpec> for RecordedCamera {
+    fn from(c: &CameraSpec) -> Self {
+        Self {
+            eye: c.eye.to_array(),
+            lookat: c.lookat.to_array(),
+            up: c.up.to_array(),
+            fov: c.fov,
+        }
+    }
+}
+
+impl From<RecordedCamera> for CameraSpec {
+    fn from(c: RecordedCamera) -> Self {
+        Self {
+            eye: DVec3::from_array(c.eye),
+            lookat: DVec3::from_array(c.lookat),
+            up: DVec3::from_array(c.up),
+            fov: c.fov,
+        }
+    }
+}
+
+impl RenderRecord {
+    /// The record of rendering `scene` (named `scene_path`) from `camera`
+    /// with `settings`.
+    pub fn new(
+        scene: &Scene,
+        scene_path: &str,
+        camera: &CameraSpec,
+        settings: RenderSettings,
+    ) -> Self {
+        Self {
+            glint_version: env!("CARGO_PKG_VERSION").to_string(),
+            scene_path: scene_path.to_string(),
+            scene_sha256: crate::sha256::sha256_hex(scene.source_text.as_bytes()),
+            scene_text: scene.source_text.clone(),
+            settings: RecordedSettings {
+                camera: camera.into(),
+                render: settings,
+                octree_params: scene.octree_params,
+            },
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum ExportError {
+    #[error("cannot write {path}: {source}")]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("cannot encode {path} as PNG: {message}")]
+    Encode { path: PathBuf, message: String },
+    #[error("cannot read {path}: {source}")]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path} is not a readable PNG: {message}")]
+    Decode { path: PathBuf, message: String },
+    #[error(
+        "{path} carries no glint metadata (text chunk `{key}` is missing): it was not written by glint, or was re-saved by a program that dropped it"
+    )]
+    Missing { path: PathBuf, key: &'static str },
+    #[error("{path}: text chunk `{key}` is malformed: {message}")]
+    Malformed {
+        path: PathBuf,
+        key: &'static str,
+        message: String,
+    },
+    #[error(
+        "{path}: the embedded scene text does not match its SHA-256 (recorded {recorded}, computed {computed})"
+    )]
+    Checksum {
+        path: PathBuf,
+        recorded: String,
+        computed: String,
+    },
+}
+
+/// Writes `frame` as PNG (with the legend strip of diagnostic views) and,
+/// when given, its record in text chunks; through a temporary file renamed
+/// into place, so a failed write never leaves a truncated image behind.
+pub fn save_png(
+    frame: &Frame,
+    path: &Path,
+    record: Option<&RenderRecord>,
+) -> Result<(), ExportError> {
+    let (rgb, height) = frame.to_annotated_rgb8();
+    let file_name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = path.with_file_name(format!(".{file_name}.{}.tmp", std::process::id()));
+    let result = write_png(&tmp, frame.width, height, &rgb, record).and_then(|()| {
+        std::fs::rename(&tmp, path).map_err(|source| ExportError::Write {
+            path: path.to_owned(),
+            source,
+        })
+    });
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+fn write_png(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgb: &[u8],
+    record: Option<&RenderRecord>,
+) -> Result<(), ExportError> {
+    let encode = |e: png::EncodingError| ExportError::Encode {
+        path: path.to_owned(),
+        message: e.to_string(),
+    };
+    let file = std::fs::File::create(path).map_err(|source| ExportError::Write {
+        path: path.to_owned(),
+        source,
+    })?;
+    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), width, height);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder
+        .add_text_chunk(
+            "Software".into(),
+            format!("glint {}", env!("CARGO_PKG_VERSION")),
+        )
+        .map_err(encode)?;
+    let mut writer = encoder.write_header().map_err(encode)?;
+    if let Some(r) = record {
+        let settings = serde_json::to_string(&r.settings).map_err(|e| ExportError::Encode {
+            path: path.to_owned(),
+            message: e.to_string(),
+        })?;
+        for (key, text, compressed) in [
+            (KEY_VERSION, r.glint_version.as_str(), false),
+            (KEY_SCENE_PATH, r.scene_path.as_str(), false),
+            (KEY_SCENE_SHA256, r.scene_sha256.as_str(), false),
+            (KEY_SETTINGS, settings.as_str(), false),
+            (KEY_SCENE, r.scene_text.as_str(), true),
+        ] {
+            let mut chunk = png::text_metadata::ITXtChunk::new(key, text);
+            chunk.compressed = compressed;
+            writer.write_text_chunk(&chunk).map_err(encode)?;
+        }
+    }
+    writer.write_image_data(rgb).map_err(encode)?;
+    writer.finish().map_err(encode)
+}
+
+/// Reads the record glint wrote into a PNG.
+pub fn read_record(path: &Path) -> Result<RenderRecord, ExportError> {
+    let file = std::fs::File::open(path).map_err(|source| ExportError::Read {
+        path: path.to_owned(),
+        source,
+    })?;
+    let decode = |message: String| ExportError::Decode {
+        path: path.to_owned(),
+        message,
+    };
+    let mut reader = png::Decoder::new(std::io::BufReader::new(file))
+        .read_info()
+        .map_err(|e| decode(e.to_string()))?;
+    // Text chunks after the image data appear only once it has been read.
+    let mut pixels = vec![0; reader.output_buffer_size().unwrap_or(0)];
+    reader
+        .next_frame(&mut pixels)
+        .map_err(|e| decode(e.to_string()))?;
+    let _ = reader.finish();
+    let info = reader.info();
+    let text = |key: &'static str| -> Result<String, ExportError> {
+        let chunk = info
+            .utf8_text
+            .iter()
+            .find(|c| c.keyword == key)
+            .ok_or_else(|| ExportError::Missing {
+                path: path.to_owned(),
+                key,
+            })?;
+        chunk.get_text().map_err(|e| ExportError::Malformed {
+            path: path.to_owned(),
+            key,
+            message: e.to_string(),
+        })
+    };
+    let settings_json = text(KEY_SETTINGS)?;
+    let settings: RecordedSettings =
+        serde_json::from_str(&settings_json).map_err(|e| ExportError::Malformed {
+            path: path.to_owned(),
+            key: KEY_SETTINGS,
+            message: e.to_string(),
+        })?;
+    let record = RenderRecord {
+        glint_version: text(KEY_VERSION)?,
+        scene_path: text(KEY_SCENE_PATH)?,
+        scene_sha256: text(KEY_SCENE_SHA256)?,
+        scene_text: text(KEY_SCENE)?,
+        settings,
+    };
+    let computed = crate::sha256::sha256_hex(record.scene_text.as_bytes());
+    if computed != record.scene_sha256 {
+        return Err(ExportError::Checksum {
+            path: path.to_owned(),
+            recorded: record.scene_sha256,
+            computed,
+        });
+    }
+    Ok(record)
+}
+
+/// The scene a record was made from: parsed from its embedded text, with
+/// meshes read relative to the recorded path (or from the binary for the
+/// built-in scene).
+pub fn load_recorded_scene(record: &RenderRecord) -> Result<Scene, crate::scene::SceneError> {
+    let mut scene = if record.scene_path == crate::scene::builtin::NAME {
+        crate::scene::builtin::load_text(&record.scene_text)?
+    } else {
+        crate::scene::load_str(
+            &record.scene_text,
+            Path::new(&record.scene_path),
+            &crate::scene::FileSystem,
+        )?
+    };
+    scene.octree_params = record.settings.octree_params;
+    Ok(scene)
+}

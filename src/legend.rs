@@ -1,0 +1,340 @@
+//! Colour map and legend strip for the diagnostic views (cost, aa-need):
+//! the command line writes the legend into the PNG so an exported picture
+//! states its own scale. A 5x7 bitmap font keeps a font crate out of the
+//! headless build.
+
+/// Viridis (van der Walt & Smith, matplotlib 2015) sampled at nine evenly
+/// spaced points; linear interpolation between them is within a few levels
+/// of the full table and keeps it perceptually ordered.
+const VIRIDIS: [[u8; 3]; 9] = [
+    [68, 1, 84],
+    [71, 44, 122],
+    [59, 81, 139],
+    [44, 113, 142],
+    [33, 144, 141],
+    [39, 173, 129],
+    [92, 200, 99],
+    [170, 220, 50],
+    [253, 231, 37],
+];
+
+/// Viridis colour of `t` in `[0, 1]` (clamped; NaN maps to the low end).
+pub fn viridis(t: f64) -> [u8; 3] {
+    let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
+    let x = t * (VIRIDIS.len() - 1) as f64;
+    let i = (x.floor() as usize).min(VIRIDIS.len() - 2);
+    let f = x - i as f64;
+    let (a, b) = (VIRIDIS[i], VIRIDIS[i + 1]);
+    [0, 1, 2].map(|c| (a[c] as f64 + (b[c] as f64 - a[c] as f64) * f).round() as u8)
+}
+
+/// What a legend strip says: a colour bar from `low` to `high` labelled at
+/// both ends, and a caption line.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Legend {
+    pub low: String,
+    pub high: String,
+    pub caption: String,
+    /// Colour of a position `t` in `[0, 1]` along the bar.
+    pub ramp: Ramp,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Ramp {
+    Viridis,
+    Grey,
+}
+
+impl Ramp {
+    pub fn color(self, t: f64) -> [u8; 3] {
+        match self {
+            Ramp::Viridis => viridis(t),
+            Ramp::Grey => [(t.clamp(0.0, 1.0) * 255.0).round() as u8; 3],
+        }
+    }
+}
+
+/// Height in pixels of the strip [`append_legend`] adds for an image `width` wide.
+pub fn legend_height(width: u32, legend: &Legend) -> u32 {
+    let s = text_scale(width, legend);
+    6 + 10 + 4 + 2 * (7 * s + 3) + 2
+}
+
+/// Double-size text where the caption fits the image width, else single.
+fn text_scale(width: u32, legend: &Legend) -> u32 {
+    let widest = text_width(&legend.caption, 2)
+        .max(text_width(&legend.low, 2) + text_width(&legend.high, 2) + 12);
+    if widest + 8 <= width { 2 } else { 1 }
+}
+
+/// Appends a legend strip below an RGB8 image of `width` x `height`;
+/// returns the new height.
+pub fn append_legend(rgb: &mut Vec<u8>, width: u32, height: u32, legend: &Legend) -> u32 {
+    let strip = legend_height(width, legend);
+    let new_height = height + strip;
+    rgb.resize((width * new_height * 3) as usize, 0);
+    let mut canvas = Canvas {
+        rgb,
+        width,
+        height: new_height,
+    };
+    canvas.fill(0, height, width, strip, [24, 24, 24]);
+    let margin = 4.min(width / 4);
+    let bar_y = height + 6;
+    let bar_w = width.saturating_sub(2 * margin).max(1);
+    for x in 0..bar_w {
+        let t = x as f64 / (bar_w - 1).max(1) as f64;
+        canvas.fill(margin + x, bar_y, 1, 10, legend.ramp.color(t));
+    }
+    let s = text_scale(width, legend);
+    let line1 = bar_y + 10 + 4;
+    let white = [235, 235, 235];
+    canvas.text(margin, line1, &legend.low, s, white);
+    let high_w = text_width(&legend.high, s);
+    canvas.text(
+        (margin + bar_w).saturating_sub(high_w),
+        line1,
+        &legend.high,
+        s,
+        white,
+    );
+    canvas.text(margin, line1 + 7 * s + 3, &legend.caption, s, white);
+    new_height
+}
+
+struct Canvas<'a> {
+    rgb: &'a mut Vec<u8>,
+    width: u32,
+    height: u32,
+}
+
+impl Canvas<'_> {
+    fn fill(&mut self, x: u32, y: u32, w: u32, h: u32, c: [u8; 3]) {
+        for yy in y..(y + h).min(self.height) {
+            for xx in x..(x + w).min(self.width) {
+                let i = ((yy * self.width + xx) * 3) as usize;
+                self.rgb[i..i + 3].copy_from_slice(&c);
+            }
+        }
+    }
+
+    /// Draws `text` with its top-left corner at `(x, y)`, clipped to the canvas.
+    fn text(&mut self, x: u32, y: u32, text: &str, scale: u32, c: [u8; 3]) {
+        let mut pen = x;
+        for ch in text.chars() {
+            if let Some(rows) = glyph(ch) {
+                for (r, row) in rows.iter().enumerate() {
+                    for (col, bit) in row.bytes().enumerate() {
+                        if bit == b'#' {
+                            self.fill(
+                                pen + col as u32 * scale,
+                                y + r as u32 * scale,
+                                scale,
+                                scale,
+                                c,
+                            );
+                        }
+                    }
+                }
+            }
+            pen += 6 * scale;
+        }
+    }
+}
+
+fn text_width(text: &str, scale: u32) -> u32 {
+    (text.chars().count() as u32 * 6).saturating_sub(1) * scale
+}
+
+/// A 5x7 glyph as seven rows of `#` (ink) and `.`; `None` draws a space.
+fn glyph(c: char) -> Option<[&'static str; 7]> {
+    let rows = match c.to_ascii_lowercase() {
+        'a' => [
+            ".....", ".....", ".###.", "....#", ".####", "#...#", ".####",
+        ],
+        'b' => [
+            "#....", "#....", "####.", "#...#", "#...#", "#...#", "####.",
+        ],
+        'c' => [
+            ".....", ".....", ".####", "#....", "#....", "#....", ".####",
+        ],
+        'd' => [
+            "....#", "....#", ".####", "#...#", "#...#", "#...#", ".####",
+        ],
+        'e' => [
+            ".....", ".....", ".###.", "#...#", "#####", "#....", ".###.",
+        ],
+        'f' => [
+            "..##.", ".#...", "####.", ".#...", ".#...", ".#...", ".#...",
+        ],
+        'g' => [
+            ".....", ".....", ".####", "#...#", ".####", "....#", ".###.",
+        ],
+        'h' => [
+            "#....", "#....", "####.", "#...#", "#...#", "#...#", "#...#",
+        ],
+        'i' => [
+            "..#..", ".....", ".##..", "..#..", "..#..", "..#..", ".###.",
+        ],
+        'j' => [
+            "...#.", ".....", "..##.", "...#.", "...#.", "#..#.", ".##..",
+        ],
+        'k' => [
+            "#....", "#....", "#..#.", "#.#..", "##...", "#.#..", "#..#.",
+        ],
+        'l' => [
+            ".##..", "..#..", "..#..", "..#..", "..#..", "..#..", ".###.",
+        ],
+        'm' => [
+            ".....", ".....", "##.#.", "#.#.#", "#.#.#", "#.#.#", "#.#.#",
+        ],
+        'n' => [
+            ".....", ".....", "####.", "#...#", "#...#", "#...#", "#...#",
+        ],
+        'o' => [
+            ".....", ".....", ".###.", "#...#", "#...#", "#...#", ".###.",
+        ],
+        'p' => [
+            ".....", ".....", "####.", "#...#", "####.", "#....", "#....",
+        ],
+        'q' => [
+            ".....", ".....", ".####", "#...#", ".####", "....#", "....#",
+        ],
+        'r' => [
+            ".....", ".....", "#.##.", "##..#", "#....", "#....", "#....",
+        ],
+        's' => [
+            ".....", ".....", ".####", "#....", ".###.", "....#", "####.",
+        ],
+        't' => [
+            ".#...", ".#...", "####.", ".#...", ".#...", ".#..#", "..##.",
+        ],
+        'u' => [
+            ".....", ".....", "#...#", "#...#", "#...#", "#..##", ".##.#",
+        ],
+        'v' => [
+            ".....", ".....", "#...#", "#...#", "#...#", ".#.#.", "..#..",
+        ],
+        'w' => [
+            ".....", ".....", "#...#", "#.#.#", "#.#.#", "#.#.#", ".#.#.",
+        ],
+        'x' => [
+            ".....", ".....", "#...#", ".#.#.", "..#..", ".#.#.", "#...#",
+        ],
+        'y' => [
+            ".....", ".....", "#...#", "#...#", ".####", "....#", ".###.",
+        ],
+        'z' => [
+            ".....", ".....", "#####", "...#.", "..#..", ".#...", "#####",
+        ],
+        '0' => [
+            ".###.", "#...#", "#..##", "#.#.#", "##..#", "#...#", ".###.",
+        ],
+        '1' => [
+            "..#..", ".##..", "..#..", "..#..", "..#..", "..#..", ".###.",
+        ],
+        '2' => [
+            ".###.", "#...#", "....#", "...#.", "..#..", ".#...", "#####",
+        ],
+        '3' => [
+            "#####", "...#.", "..#..", "...#.", "....#", "#...#", ".###.",
+        ],
+        '4' => [
+            "...#.", "..##.", ".#.#.", "#..#.", "#####", "...#.", "...#.",
+        ],
+        '5' => [
+            "#####", "#....", "####.", "....#", "....#", "#...#", ".###.",
+        ],
+        '6' => [
+            "..##.", ".#...", "#....", "####.", "#...#", "#...#", ".###.",
+        ],
+        '7' => [
+            "#####", "....#", "...#.", "..#..", ".#...", ".#...", ".#...",
+        ],
+        '8' => [
+            ".###.", "#...#", "#...#", ".###.", "#...#", "#...#", ".###.",
+        ],
+        '9' => [
+            ".###.", "#...#", "#...#", ".####", "....#", "...#.", ".##..",
+        ],
+        '.' => [
+            ".....", ".....", ".....", ".....", ".....", ".##..", ".##..",
+        ],
+        ',' => [
+            ".....", ".....", ".....", ".....", ".##..", "..#..", ".#...",
+        ],
+        '-' => [
+            ".....", ".....", ".....", "#####", ".....", ".....", ".....",
+        ],
+        '+' => [
+            ".....", "..#..", "..#..", "#####", "..#..", "..#..", ".....",
+        ],
+        ':' => [
+            ".....", ".##..", ".##..", ".....", ".##..", ".##..", ".....",
+        ],
+        '/' => [
+            ".....", "....#", "...#.", "..#..", ".#...", "#....", ".....",
+        ],
+        '%' => [
+            "##...", "##..#", "...#.", "..#..", ".#...", "#..##", "...##",
+        ],
+        '|' => [
+            "..#..", "..#..", "..#..", "..#..", "..#..", "..#..", "..#..",
+        ],
+        '>' => [
+            ".#...", "..#..", "...#.", "....#", "...#.", "..#..", ".#...",
+        ],
+        '=' => [
+            ".....", ".....", "#####", ".....", "#####", ".....", ".....",
+        ],
+        '(' => [
+            "...#.", "..#..", ".#...", ".#...", ".#...", "..#..", "...#.",
+        ],
+        ')' => [
+            ".#...", "..#..", "...#.", "...#.", "...#.", "..#..", ".#...",
+        ],
+        _ => return None,
+    };
+    Some(rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn viridis_runs_dark_to_bright_and_clamps() {
+        assert_eq!(viridis(0.0), VIRIDIS[0]);
+        assert_eq!(viridis(1.0), VIRIDIS[8]);
+        assert_eq!(viridis(-3.0), VIRIDIS[0]);
+        assert_eq!(viridis(f64::NAN), VIRIDIS[0]);
+        // Perceptual order: luminance grows along the map.
+        let luma = |c: [u8; 3]| 0.2126 * c[0] as f64 + 0.7152 * c[1] as f64 + 0.0722 * c[2] as f64;
+        let mut last = -1.0;
+        for k in 0..=100 {
+            let l = luma(viridis(k as f64 / 100.0));
+            assert!(l > last, "luminance falls at {k}%");
+            last = l;
+        }
+    }
+
+    #[test]
+    fn legend_strip_is_appended_with_ink() {
+        let (w, h) = (64u32, 8u32);
+        let mut rgb = vec![7u8; (w * h * 3) as usize];
+        let legend = Legend {
+            low: "0".into(),
+            high: "99".into(),
+            caption: "tests".into(),
+            ramp: Ramp::Viridis,
+        };
+        let new_h = append_legend(&mut rgb, w, h, &legend);
+        assert_eq!(new_h, h + legend_height(w, &legend));
+        assert_eq!(rgb.len(), (w * new_h * 3) as usize);
+        // The image itself is untouched; the strip holds bar and text colours.
+        assert!(rgb[..(w * h * 3) as usize].iter().all(|&b| b == 7));
+        let strip = &rgb[(w * h * 3) as usize..];
+        assert!(strip.chunks(3).any(|p| p == [235, 235, 235]));
+        assert!(strip.chunks(3).any(|p| p == VIRIDIS[8]));
+    }
+}

@@ -1,0 +1,385 @@
+//! Seeing inside the render: a pixel's ray tree, per-pixel cost, the
+//! aa-need view and reproducible PNG exports.
+
+mod common;
+
+use std::path::Path;
+use std::process::Command;
+
+use glint::accel::Octree;
+use glint::math::DVec3;
+use glint::ray_tree::{RayKind, RayNode};
+use glint::render::{Frame, RenderSettings, Renderer, ViewMode, image_error};
+use glint::scene::{FileSystem, Scene};
+
+/// A mirror sphere and a glass sphere over a floor, two lights.
+const MIRROR_AND_GLASS: &str = r#"
+[camera]
+eye = [0, 1.5, 6]
+lookat = [0, 1, 0]
+up = [0, 1, 0]
+fov = 40
+
+[image]
+width = 64
+height = 48
+samples = 1
+max_depth = 4
+background = [0.5, 0.6, 0.8]
+ambient = [0.1, 0.1, 0.1]
+
+[materials.mirror]
+color = [0.9, 0.9, 0.9]
+kd = 0.2
+reflectivity = 0.7
+
+[materials.glass]
+color = [1, 1, 1]
+kd = 0.05
+ks = 0.5
+shininess = 200
+reflectivity = 0.1
+transparency = 0.85
+ior = 1.5
+
+[materials.floor]
+color = [0.8, 0.7, 0.6]
+
+[[lights]]
+position = [-3, 6, 4]
+color = [0.8, 0.8, 0.8]
+
+[[lights]]
+position = [4, 5, 2]
+color = [0.4, 0.4, 0.4]
+
+[[objects]]
+kind = "plane"
+material = "floor"
+point = [0, 0, 0]
+normal = [0, 1, 0]
+
+[[objects]]
+kind = "sphere"
+material = "glass"
+center = [0.9, 1, 0]
+radius = 0.8
+
+[[objects]]
+kind = "sphere"
+material = "mirror"
+center = [-1.1, 1, -0.5]
+radius = 0.8
+"#;
+
+fn scene_from(text: &str) -> Scene {
+    glint::scene::load_str(text, Path::new("test.toml"), &FileSystem).unwrap()
+}
+
+fn settings(scene: &Scene, view: ViewMode, use_octree: bool) -> RenderSettings {
+    RenderSettings {
+        view,
+        use_octree,
+        ..RenderSettings::from_scene(scene)
+    }
+}
+
+/// Pixel whose centre eye ray hits shape `object` (scanning row-major).
+fn pixel_hitting(renderer: &Renderer, w: u32, h: u32, object: u32) -> (u32, u32) {
+    for j in 0..h {
+        for i in 0..w {
+            let t = renderer.ray_tree(i, j);
+            if t.hit.as_ref().is_some_and(|hit| hit.object == object) {
+                return (i, j);
+            }
+        }
+    }
+    panic!("no pixel sees object {object}");
+}
+
+fn check_sums(node: &RayNode, max_depth: u32, lights: usize) {
+    assert!(
+        node.depth <= max_depth,
+        "depth {} > {max_depth}",
+        node.depth
+    );
+    if node.hit.is_some() {
+        assert_eq!(node.shadows.len(), lights, "one verdict per light");
+    } else {
+        assert!(node.shadows.is_empty() && node.children.is_empty());
+    }
+    if node.depth == max_depth {
+        assert!(
+            node.children.is_empty(),
+            "a ray at max depth spawns nothing"
+        );
+    }
+    // Colour = local term + weighted children, channel by channel.
+    let mut sum = DVec3::from_array(node.local_color);
+    for c in &node.children {
+        assert_eq!(c.depth, node.depth + 1);
+        sum += DVec3::from_array(c.contribution);
+        check_sums(c, max_depth, lights);
+    }
+    let color = DVec3::from_array(node.color);
+    assert!(
+        (sum - color).abs().max_element() < 1e-12,
+        "local + children = {sum} but the ray's colour is {color}"
+    );
+    // Direct light is the sum of the lights' shares.
+    if node.hit.is_some() {
+        let direct: DVec3 = node
+            .shadows
+            .iter()
+            .map(|s| DVec3::from_array(s.color))
+            .sum();
+        assert!(
+            direct.max_element() <= node.local_color.iter().cloned().fold(0.0, f64::max) + 1e-12
+        );
+    }
+}
+
+#[test]
+fn ray_tree_of_a_glass_pixel_has_reflection_and_refraction_and_sums_to_the_pixel() {
+    let scene = scene_from(MIRROR_AND_GLASS);
+    let octree = Octree::build(&scene.shapes, scene.octree_params);
+    let s = settings(&scene, ViewMode::Shaded, true);
+    let renderer = Renderer::new(&scene, &octree, s).unwrap();
+    let (frame, _) = renderer.render(false, None);
+    let rgb = frame.to_rgb8();
+    for (object, kinds) in [
+        (1u32, vec![RayKind::Refraction, RayKind::Reflection]),
+        (2, vec![RayKind::Reflection]),
+    ] {
+        let (i, j) = pixel_hitting(&renderer, s.width, s.height, object);
+        let tree = renderer.ray_tree(i, j);
+        assert_eq!(tree.kind, RayKind::Eye);
+        assert_eq!(tree.depth, 1);
+        let children: Vec<RayKind> = tree.children.iter().map(|c| c.kind).collect();
+        assert_eq!(children, kinds, "children of the eye ray at {i},{j}");
+        check_sums(&tree, s.max_depth, scene.lights.len());
+        // The root colour is the 1-sample pixel, within 1/255 after encoding.
+        let p = ((j * s.width + i) * 3) as usize;
+        let root = DVec3::from_array(tree.color);
+        let enc = [root.x, root.y, root.z]
+            .map(|c| (glint::render::linear_to_srgb(c) * 255.0).round() as i32);
+        for c in 0..3 {
+            assert!(
+                (enc[c] - rgb[p + c] as i32).abs() <= 1,
+                "pixel {i},{j} channel {c}: tree {} image {}",
+                enc[c],
+                rgb[p + c]
+            );
+        }
+        if object == 1 {
+            // The refracted ray crosses the glass and leaves it again.
+            let deepest = tree.walk().iter().map(|n| n.depth).max().unwrap();
+            assert!(deepest >= 3, "glass rays recurse (deepest {deepest})");
+        }
+    }
+}
+
+#[test]
+fn cost_counts_one_test_per_primitive_without_the_octree_and_none_outside_it() {
+    // Spheres only: every primitive is bounded, so a ray that misses the
+    // octree's root box tests nothing at all.
+    let text = MIRROR_AND_GLASS.replace(
+        "[[objects]]\nkind = \"plane\"\nmaterial = \"floor\"\npoint = [0, 0, 0]\nnormal = [0, 1, 0]\n",
+        "",
+    );
+    let scene = scene_from(&text);
+    assert_eq!(scene.shapes.len(), 2);
+    let octree = Octree::build(&scene.shapes, scene.octree_params);
+    let corner = |use_octree| {
+        let s = settings(&scene, ViewMode::Cost, use_octree);
+        let (frame, _) = Renderer::new(&scene, &octree, s)
+            .unwrap()
+            .render(false, None);
+        (frame.pixels[0], frame)
+    };
+    let (off, frame_off) = corner(false);
+    assert_eq!(
+        off.x,
+        scene.shapes.len() as f64,
+        "octree off: the missing eye ray tests every primitive once"
+    );
+    assert_eq!(off.y, 0.0, "no traversal without the octree");
+    let (on, frame_on) = corner(true);
+    assert_eq!(
+        on.x, 0.0,
+        "octree on: a ray missing the root box tests nothing"
+    );
+    // Summed over the frame, the cost view counts what --stats counts.
+    let s = settings(&scene, ViewMode::Shaded, true);
+    let (_, counts) = Renderer::new(&scene, &octree, s)
+        .unwrap()
+        .render(true, None);
+    let total_tests: f64 = frame_on.pixels.iter().map(|p| p.x).sum();
+    assert_eq!(total_tests, counts.work.intersection_tests as f64);
+    let summary = frame_off.cost_summary().unwrap();
+    assert!(summary.min >= 2.0 && summary.max >= summary.mean);
+}
+
+#[test]
+fn aa_need_view_agrees_with_the_study_measure() {
+    let scene = common::load("scenes/default.toml");
+    let octree = Octree::build(&scene.shapes, scene.octree_params);
+    let mut s = settings(&scene, ViewMode::AaNeed, true);
+    s.width = 96;
+    s.height = 72;
+    let (need, _) =
+        glint::render::render_view(&scene, &octree, s, &scene.camera, false, None).unwrap();
+    let shaded = |samples| {
+        let st = RenderSettings {
+            samples,
+            view: ViewMode::Shaded,
+            ..s
+        };
+        Renderer::new(&scene, &octree, st)
+            .unwrap()
+            .render(false, None)
+            .0
+    };
+    let (one, sixteen) = (shaded(1), shaded(16));
+    let study = image_error(&one.pixels, &sixteen.pixels).visible_fraction;
+    let view = need
+        .pixels
+        .iter()
+        .filter(|p| p.max_element() > 1.0 / 255.0)
+        .count() as f64
+        / need.pixels.len() as f64;
+    assert_eq!(view, study, "aa-need fraction {view} vs study {study}");
+    assert!(
+        view > 0.0 && view < 0.5,
+        "some edges need anti-aliasing: {view}"
+    );
+    assert_eq!(
+        Frame::aa_need(&one, &one)
+            .pixels
+            .iter()
+            .filter(|p| p.max_element() > 0.0)
+            .count(),
+        0
+    );
+    let legend = need.legend().unwrap();
+    assert!(
+        legend.caption.contains(&format!("{:.1}%", 100.0 * study)),
+        "legend states the fraction: {}",
+        legend.caption
+    );
+}
+
+fn glint() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_glint"))
+}
+
+fn decode(path: &Path) -> (u32, u32, Vec<u8>) {
+    let img = image::open(path).unwrap().to_rgb8();
+    (img.width(), img.height(), img.into_raw())
+}
+
+#[test]
+fn exports_record_how_they_were_made_and_render_again_identically() {
+    let dir = std::env::temp_dir().join(format!("glint-export-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let first = dir.join("first.png");
+    let again = dir.join("again.png");
+    let scene = common::repo_path("scenes/glass.toml");
+    for view in ["shaded", "cost"] {
+        let out = glint()
+            .args(["render", scene.to_str().unwrap(), "-o"])
+            .arg(&first)
+            .args(["--width", "40", "--height", "30", "--samples", "16"])
+            .args([
+                "--max-depth",
+                "3",
+                "--octree-leaf-size",
+                "4",
+                "--view",
+                view,
+            ])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let record = glint::export::read_record(&first).unwrap();
+        assert_eq!(record.settings.render.samples, 16);
+        assert_eq!(record.settings.render.max_depth, 3);
+        assert_eq!(record.settings.octree_params.leaf_size, 4);
+        assert_eq!(record.settings.render.view.name(), view);
+        let text = std::fs::read_to_string(&scene).unwrap();
+        assert_eq!(record.scene_text, text);
+        assert_eq!(
+            record.scene_sha256,
+            glint::sha256::sha256_hex(text.as_bytes())
+        );
+
+        let out = glint()
+            .args(["render", "--from-png"])
+            .arg(&first)
+            .arg("-o")
+            .arg(&again)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let (a, b) = (decode(&first), decode(&again));
+        assert_eq!((a.0, a.1), (b.0, b.1));
+        let (n, largest) = common::diff(&a.2, &b.2, 0);
+        assert_eq!(n, 0, "{view}: {n} pixels differ (largest {largest})");
+    }
+
+    // `glint info` prints the record; a PNG without one is a clear error.
+    let out = glint().arg("info").arg(&first).output().unwrap();
+    let info = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && info.contains("samples       16"),
+        "{info}"
+    );
+    let plain = dir.join("plain.png");
+    image::RgbImage::new(4, 4).save(&plain).unwrap();
+    for args in [vec!["info"], vec!["render", "-o", "x.png", "--from-png"]] {
+        let out = glint().args(&args).arg(&plain).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success());
+        assert!(
+            err.contains("plain.png") && err.contains("no glint metadata"),
+            "{args:?}: {err}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn trace_pixel_prints_the_tree_as_json() {
+    let out = glint()
+        .args(["render"])
+        .arg(common::repo_path("scenes/glass.toml"))
+        .args(["--width", "48", "--height", "36", "--trace-pixel", "24,20"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["pixel"], serde_json::json!([24, 20]));
+    assert_eq!(v["tree"]["kind"], "eye");
+    assert_eq!(v["tree"]["depth"], 1);
+    assert!(v["tree"]["hit"]["material"].is_string(), "{v}");
+    let out = glint()
+        .args(["render"])
+        .arg(common::repo_path("scenes/glass.toml"))
+        .args(["--width", "48", "--height", "36", "--trace-pixel", "48,0"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("outside the 48x36 image"));
+}
