@@ -108,6 +108,28 @@ impl Camera {
     }
 }
 
+impl Camera {
+    /// Depth of `p` along the view direction (positive in front of the eye).
+    pub fn view_depth(&self, p: DVec3) -> f64 {
+        -(p - self.eye).dot(self.w)
+    }
+
+    /// Continuous image coordinates of `p` (pixels, x to the right, y down
+    /// from the top-left corner), for points with positive view depth.
+    pub fn project(&self, p: DVec3) -> Option<(f64, f64)> {
+        let d = p - self.eye;
+        let z = -d.dot(self.w);
+        if !(z > 0.0) {
+            return None;
+        }
+        let (x, y) = (d.dot(self.u) / z, d.dot(self.v) / z);
+        Some((
+            (x - self.left) / self.pixel_size,
+            (self.top - y) / self.pixel_size,
+        ))
+    }
+}
+
 /// Sub-pixel offsets for `samples` rays per pixel: the centre for 1, a regular
 /// `k x k` grid at `(a + 0.5) / k` for `k^2` samples (4x4 for 16).
 pub fn sample_offsets(samples: u32) -> Vec<(f64, f64)> {

@@ -38,6 +38,9 @@ pub struct RecordedSettings {
     #[serde(flatten)]
     pub render: RenderSettings,
     pub octree_params: OctreeParams,
+    /// Octree overlay drawn down to this level, if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub overlay_depth: Option<u32>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -88,6 +91,7 @@ impl RenderRecord {
                 camera: camera.into(),
                 render: settings,
                 octree_params: scene.octree_params,
+                overlay_depth: None,
             },
         }
     }
@@ -138,12 +142,23 @@ pub fn save_png(
     record: Option<&RenderRecord>,
 ) -> Result<(), ExportError> {
     let (rgb, height) = frame.to_annotated_rgb8();
+    save_rgb_png(path, frame.width, height, &rgb, record)
+}
+
+/// Writes an RGB8 picture (already annotated) like [`save_png`].
+pub fn save_rgb_png(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgb: &[u8],
+    record: Option<&RenderRecord>,
+) -> Result<(), ExportError> {
     let file_name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     let tmp = path.with_file_name(format!(".{file_name}.{}.tmp", std::process::id()));
-    let result = write_png(&tmp, frame.width, height, &rgb, record).and_then(|()| {
+    let result = write_png(&tmp, width, height, rgb, record).and_then(|()| {
         std::fs::rename(&tmp, path).map_err(|source| ExportError::Write {
             path: path.to_owned(),
             source,

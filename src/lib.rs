@@ -19,6 +19,7 @@ pub mod export;
 pub mod legend;
 pub mod material;
 pub mod math;
+pub mod overlay;
 pub mod ray_tree;
 pub mod render;
 pub mod scene;

@@ -4,7 +4,7 @@
 
 mod octree;
 
-pub use octree::{MAX_OCTREE_DEPTH, Octree, OctreeParams, OctreeStats};
+pub use octree::{MAX_OCTREE_DEPTH, Octree, OctreeCell, OctreeParams, OctreeStats};
 
 use crate::shapes::{PreparedRay, Shape, ShapeHit};
 use crate::stats::Counter;

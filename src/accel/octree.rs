@@ -61,6 +61,17 @@ pub struct OctreeStats {
     pub memory_bytes: u64,
 }
 
+/// A cell of the octree as the overlay draws it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OctreeCell {
+    pub bounds: Aabb,
+    /// Level of the cell; the root is 0.
+    pub depth: u32,
+    /// Primitive references in the cell (summed over its leaves when it
+    /// stands for a subtree).
+    pub references: u64,
+}
+
 /// Leaf: `refs[first .. first + count]`. Interior: eight children stored
 /// consecutively from `first`, octant bit 0 = upper x, bit 1 = upper y,
 /// bit 2 = upper z. 8 bytes, so a cache line holds a node's eight children.
@@ -185,6 +196,64 @@ impl Octree {
 
     pub fn bounds(&self) -> Aabb {
         self.bounds
+    }
+
+    /// The cells to draw for an overlay down to level `depth`: every
+    /// non-empty leaf above that level, and every non-empty node at it
+    /// (standing for its subtree), with the references beneath it.
+    pub fn cells(&self, depth: u32) -> Vec<OctreeCell> {
+        let mut out = Vec::new();
+        if !self.nodes.is_empty() && !self.bounds.is_empty() {
+            self.collect_cells(0, self.bounds.min, self.bounds.max, 0, depth, &mut out);
+        }
+        out
+    }
+
+    /// Returns the references under node `index`.
+    fn collect_cells(
+        &self,
+        index: usize,
+        min: DVec3,
+        max: DVec3,
+        level: u32,
+        depth: u32,
+        out: &mut Vec<OctreeCell>,
+    ) -> u64 {
+        let node = self.nodes[index];
+        if node.count != INTERIOR {
+            if node.count > 0 {
+                out.push(OctreeCell {
+                    bounds: Aabb::new(min, max),
+                    depth: level,
+                    references: node.count as u64,
+                });
+            }
+            return node.count as u64;
+        }
+        let mid = centre(min, max);
+        let at_limit = level >= depth;
+        let mut below = Vec::new();
+        let target = if at_limit { &mut below } else { &mut *out };
+        let mut total = 0;
+        for child in 0..8 {
+            let (lo, hi) = octant(min, max, mid, child);
+            total += self.collect_cells(
+                node.first as usize + child,
+                lo,
+                hi,
+                level + 1,
+                depth,
+                target,
+            );
+        }
+        if at_limit && total > 0 {
+            out.push(OctreeCell {
+                bounds: Aabb::new(min, max),
+                depth: level,
+                references: total,
+            });
+        }
+        total
     }
 
     /// Closest hit with `0 < t < t_max`.

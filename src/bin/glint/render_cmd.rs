@@ -57,6 +57,19 @@ pub struct RenderArgs {
     /// Y from the top, both from 0.
     #[arg(long, value_name = "X,Y", value_parser = parse_pixel)]
     pub trace_pixel: Option<(u32, u32)>,
+    /// Draw the octree's cells over the image as wireframe boxes, coloured
+    /// by how many primitives each references.
+    #[arg(long, value_enum)]
+    pub overlay: Option<OverlayKind>,
+    /// Deepest octree level the overlay draws (deeper subtrees are drawn
+    /// as one box at this level).
+    #[arg(long, default_value_t = 4)]
+    pub overlay_depth: u32,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum OverlayKind {
+    Octree,
 }
 
 fn parse_pixel(s: &str) -> std::result::Result<(u32, u32), String> {
@@ -129,6 +142,7 @@ struct RaysJson {
 
 pub fn run(args: &RenderArgs) -> Result<()> {
     let load_start = Instant::now();
+    let mut overlay_depth = args.overlay.map(|_| args.overlay_depth);
     let (mut scene, scene_name, mut settings, camera) = match (&args.from_png, &args.scene) {
         (Some(png), _) => {
             let record = glint::export::read_record(png)?;
@@ -143,6 +157,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             let scene = glint::export::load_recorded_scene(&record)
                 .with_context(|| format!("cannot load the scene recorded in {}", png.display()))?;
             let settings = record.settings.render;
+            overlay_depth = overlay_depth.or(record.settings.overlay_depth);
             (
                 scene,
                 record.scene_path.clone(),
@@ -170,7 +185,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let pool = thread_pool(args.threads)?;
     let threads = pool.current_num_threads();
     let build_start = Instant::now();
-    let octree = if settings.use_octree {
+    let octree = if settings.use_octree || overlay_depth.is_some() {
         pool.install(|| Octree::build(&scene.shapes, scene.octree_params))
     } else {
         Octree::build(&[], scene.octree_params)
@@ -218,8 +233,17 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    let record = glint::export::RenderRecord::new(&scene, &scene_name, &camera, settings);
-    glint::export::save_png(&frame, output, Some(&record))?;
+    let mut record = glint::export::RenderRecord::new(&scene, &scene_name, &camera, settings);
+    match overlay_depth {
+        Some(depth) => {
+            record.settings.overlay_depth = Some(depth);
+            let view = glint::camera::Camera::new(&camera, settings.width, settings.height)?;
+            let (rgb, height) =
+                glint::overlay::annotate(&frame, &view, &octree.cells(depth), depth);
+            glint::export::save_rgb_png(output, frame.width, height, &rgb, Some(&record))?;
+        }
+        None => glint::export::save_png(&frame, output, Some(&record))?,
+    }
 
     if scene.dropped_triangles > 0 {
         eprintln!(
