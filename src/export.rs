@@ -32,7 +32,7 @@ pub struct RenderRecord {
 }
 
 /// The settings part of a record, stored as JSON.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RecordedSettings {
     pub camera: RecordedCamera,
     #[serde(flatten)]
@@ -41,6 +41,17 @@ pub struct RecordedSettings {
     /// Octree overlay drawn down to this level, if any.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub overlay_depth: Option<u32>,
+    /// Lights and materials as edited in the viewer, replacing the scene
+    /// file's (absent when they are the file's own).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub edits: Option<SceneEdits>,
+}
+
+/// Lights and materials that replace a scene file's own.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SceneEdits {
+    pub lights: Vec<crate::material::Light>,
+    pub materials: Vec<crate::material::Material>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -92,6 +103,7 @@ impl RenderRecord {
                 render: settings,
                 octree_params: scene.octree_params,
                 overlay_depth: None,
+                edits: None,
             },
         }
     }
@@ -123,6 +135,10 @@ pub enum ExportError {
         key: &'static str,
         message: String,
     },
+    #[error(transparent)]
+    Scene(#[from] crate::scene::SceneError),
+    #[error("the recorded light and material edits do not fit the recorded scene {scene}")]
+    EditsMismatch { scene: String },
     #[error(
         "{path}: the embedded scene text does not match its SHA-256 (recorded {recorded}, computed {computed})"
     )]
@@ -279,7 +295,7 @@ pub fn read_record(path: &Path) -> Result<RenderRecord, ExportError> {
 /// The scene a record was made from: parsed from its embedded text, with
 /// meshes read relative to the recorded path (or from the binary for the
 /// built-in scene).
-pub fn load_recorded_scene(record: &RenderRecord) -> Result<Scene, crate::scene::SceneError> {
+pub fn load_recorded_scene(record: &RenderRecord) -> Result<Scene, ExportError> {
     let mut scene = if record.scene_path == crate::scene::builtin::NAME {
         crate::scene::builtin::load_text(&record.scene_text)?
     } else {
@@ -290,5 +306,18 @@ pub fn load_recorded_scene(record: &RenderRecord) -> Result<Scene, crate::scene:
         )?
     };
     scene.octree_params = record.settings.octree_params;
+    if let Some(edits) = &record.settings.edits {
+        // Edits made in the viewer keep the file's counts; anything else
+        // means the record does not belong to this scene text.
+        if edits.lights.len() != scene.lights.len()
+            || edits.materials.len() != scene.materials.len()
+        {
+            return Err(ExportError::EditsMismatch {
+                scene: record.scene_path.clone(),
+            });
+        }
+        scene.lights = edits.lights.clone();
+        scene.materials = edits.materials.clone();
+    }
     Ok(scene)
 }

@@ -2,7 +2,7 @@
 
 use crate::math::{Color, DVec3};
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Material {
     pub name: String,
     pub color: Color,
@@ -41,7 +41,7 @@ impl Default for Material {
 }
 
 /// Point light with no distance falloff, as in the classic Whitted model.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Light {
     pub position: DVec3,
     pub color: Color,

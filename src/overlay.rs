@@ -38,7 +38,7 @@ fn edges(min: DVec3, max: DVec3) -> [(DVec3, DVec3); 12] {
 /// Image-space end points of segment `a`-`b`, cut at a plane just in front
 /// of the eye so segments passing behind the camera still draw their
 /// visible part.
-fn project_segment(camera: &Camera, a: DVec3, b: DVec3) -> Option<((f64, f64), (f64, f64))> {
+pub fn project_segment(camera: &Camera, a: DVec3, b: DVec3) -> Option<((f64, f64), (f64, f64))> {
     let near = 1e-6 * (a - camera.eye).length().max((b - camera.eye).length());
     let (za, zb) = (camera.view_depth(a), camera.view_depth(b));
     if za <= near && zb <= near {
@@ -48,6 +48,14 @@ fn project_segment(camera: &Camera, a: DVec3, b: DVec3) -> Option<((f64, f64), (
     let a2 = if za <= near { cut(a, za, b, zb) } else { a };
     let b2 = if zb <= near { cut(b, zb, a, za) } else { b };
     Some((camera.project(a2)?, camera.project(b2)?))
+}
+
+/// The projected edges of `cell` (image coordinates, not clipped to the image).
+pub fn cell_segments(camera: &Camera, cell: &OctreeCell) -> Vec<((f64, f64), (f64, f64))> {
+    edges(cell.bounds.min, cell.bounds.max)
+        .into_iter()
+        .filter_map(|(a, b)| project_segment(camera, a, b))
+        .collect()
 }
 
 /// Liang–Barsky clipping of a segment to `[0, w] x [0, h]`.
@@ -85,10 +93,7 @@ pub fn draw_cells(rgb: &mut [u8], camera: &Camera, cells: &[OctreeCell]) {
     order.sort_by_key(|c| c.references);
     for cell in order {
         let color = cell_color(cell.references, most);
-        for (a, b) in edges(cell.bounds.min, cell.bounds.max) {
-            let Some((p, q)) = project_segment(camera, a, b) else {
-                continue;
-            };
+        for (p, q) in cell_segments(camera, cell) {
             let Some((p, q)) = clip(p, q, w as f64 - 1e-9, h as f64 - 1e-9) else {
                 continue;
             };

@@ -81,7 +81,7 @@ fn editing_a_light_restarts() {
 
 #[test]
 fn export_writes_the_displayed_buffer() {
-    let mut h = harness(small_app());
+    let h = harness(small_app());
     let generation = h.state().worker().generation();
     assert!(
         h.state().worker().wait_finished(generation, WAIT),
@@ -200,4 +200,146 @@ fn a_new_job_cancels_the_old_one_within_a_tile() {
             .iter()
             .all(|r| r.generation != first || r.kind == PassKind::OneSample)
     );
+}
+
+/// Runs frames until the current generation's final pass is on screen.
+fn settle(h: &mut Harness<'static, GlintApp>) {
+    let generation = h.state().worker().generation();
+    assert!(h.state().worker().wait_finished(generation, WAIT));
+    h.run_steps(3);
+    assert!(h.state().final_pass_shown(), "final pass on screen");
+}
+
+#[test]
+fn pin_as_a_then_octree_off_reads_zero_pixels_differ() {
+    let mut app = small_app();
+    app.settings_mut().use_octree = true;
+    let mut h = harness(app);
+    settle(&mut h);
+    h.get_by_label("Pin as A").click();
+    h.run_steps(2);
+    assert!(h.state().compare().is_some(), "A is pinned");
+    h.get_by_label("Octree").click();
+    h.run_steps(2);
+    assert!(!h.state().settings().use_octree);
+    settle(&mut h);
+    let stats = h.state().compare_stats().expect("A and B compared");
+    assert_eq!(stats.differing, 0, "octree on vs off: {stats:?}");
+    assert_eq!(stats.total, 64 * 48);
+    h.get_by_label_contains("0 pixels differ of 3072");
+
+    // 1 against 16 samples: exactly the pixels anti-aliasing changes.
+    h.get_by_label("Pin as A").click();
+    h.run_steps(2);
+    let aa = h.state().anti_aliasing();
+    h.get_by_label("Anti-aliasing (16 samples, 4x4 grid)")
+        .click();
+    h.run_steps(2);
+    assert_eq!(h.state().anti_aliasing(), !aa);
+    settle(&mut h);
+    let stats = h.state().compare_stats().unwrap();
+    assert!(
+        stats.differing > 0 && stats.differing < stats.total / 2,
+        "AA changes edge pixels only: {stats:?}"
+    );
+}
+
+#[test]
+fn dragging_the_divider_moves_it_and_not_the_camera() {
+    let mut h = harness(small_app());
+    settle(&mut h);
+    h.state_mut().pin_as_a();
+    h.run_steps(2);
+    let rect = h.state().image_rect().unwrap();
+    let camera = *h.state().camera();
+    let start = egui::pos2(rect.center().x, rect.center().y);
+    let dx = rect.width() * 0.25;
+    h.hover_at(start);
+    h.run_steps(1);
+    h.drag_at(start);
+    h.run_steps(1);
+    for k in 1..=4 {
+        h.hover_at(start + egui::vec2(dx * k as f32 / 4.0, 0.0));
+        h.run_steps(1);
+    }
+    h.drop_at(start + egui::vec2(dx, 0.0));
+    h.run_steps(2);
+    let divider = h.state().compare().unwrap().divider;
+    assert!(
+        (divider - 0.75).abs() < 0.05,
+        "divider moved from 0.5 to {divider}"
+    );
+    assert_eq!(*h.state().camera(), camera, "the camera did not orbit");
+}
+
+#[test]
+fn clicking_in_inspect_mode_picks_the_pixel_and_its_ray_tree() {
+    let mut h = harness(small_app());
+    settle(&mut h);
+    h.get_by_label("Inspect: click picks a pixel").click();
+    h.run_steps(2);
+    let rect = h.state().image_rect().unwrap();
+    // The centre of pixel (40, 30) of the 64x48 image.
+    let at = rect.min + egui::vec2(rect.width() * 40.5 / 64.0, rect.height() * 30.5 / 48.0);
+    let camera = *h.state().camera();
+    h.hover_at(at);
+    h.run_steps(1);
+    for pressed in [true, false] {
+        h.event(egui::Event::PointerButton {
+            pos: at,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: egui::Modifiers::NONE,
+        });
+        h.run_steps(1);
+    }
+    h.run_steps(1);
+    let ins = h.state().inspection().expect("a pixel was picked");
+    assert_eq!(ins.pixel, (40, 30));
+    assert_eq!(ins.tree.depth, 1);
+    assert!(
+        ins.tree.hit.is_some(),
+        "the pixel sees the sphere or the floor"
+    );
+    assert_eq!(
+        *h.state().camera(),
+        camera,
+        "a click does not move the camera"
+    );
+    h.get_by_label_contains("pixel 40,30");
+}
+
+#[test]
+fn a_viewer_export_renders_again_identically_from_its_metadata() {
+    let mut h = harness(small_app());
+    settle(&mut h);
+    // An edit made in the window must travel with the export.
+    h.state_mut().scene_mut().materials[0].color = glint::math::DVec3::new(0.9, 0.1, 0.6);
+    h.state_mut().scene_mut().lights[0].position.y += 2.0;
+    h.run_steps(2);
+    settle(&mut h);
+    let dir = std::env::temp_dir().join(format!("glint-viewer-export-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (first, again) = (dir.join("first.png"), dir.join("again.png"));
+    h.state().export_to(&first).unwrap();
+    let record = glint::export::read_record(&first).unwrap();
+    assert!(record.settings.edits.is_some(), "edits are recorded");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_glint"))
+        .args(["render", "--from-png"])
+        .arg(&first)
+        .arg("-o")
+        .arg(&again)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let a = image::open(&first).unwrap().to_rgb8();
+    let b = image::open(&again).unwrap().to_rgb8();
+    assert_eq!(a.dimensions(), b.dimensions());
+    let (n, largest) = common::diff(a.as_raw(), b.as_raw(), 0);
+    assert_eq!(n, 0, "{n} pixels differ (largest {largest})");
+    let _ = std::fs::remove_dir_all(&dir);
 }

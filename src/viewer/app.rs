@@ -12,6 +12,7 @@ use super::orbit;
 use super::worker::{Job, PassKind, PassRecord, Worker};
 use crate::accel::Octree;
 use crate::camera::CameraSpec;
+use crate::export::{RenderRecord, SceneEdits};
 use crate::render::{RenderSettings, ViewMode};
 use crate::scene::Scene;
 
@@ -57,6 +58,22 @@ pub struct ViewerOptions {
     pub anti_aliasing: Option<bool>,
     /// Image size overriding the scene's.
     pub size: Option<(u32, u32)>,
+    /// Start with the octree overlay drawn down to this level.
+    pub overlay_depth: Option<u32>,
+    /// Start with this pixel's ray tree inspected.
+    pub inspect: Option<(u32, u32)>,
+    /// Start by comparing against the image with this setting flipped:
+    /// A is rendered with it flipped and pinned, then B as given.
+    pub compare: Option<CompareSetting>,
+    /// Show the comparison as a difference rather than a split.
+    pub compare_difference: bool,
+}
+
+/// A setting `--compare` flips for the A image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CompareSetting {
+    Octree,
+    AntiAliasing,
 }
 
 /// A message shown in the status area.
@@ -110,6 +127,11 @@ pub struct GlintApp {
     /// Set when the app wants the window closed (after `--screenshot`).
     pub exit_requested: bool,
     started: Instant,
+    pub(crate) inspect: super::inspect::InspectState,
+    /// `--compare` waiting for A's final pass to pin it.
+    compare_pending: Option<CompareSetting>,
+    /// Where the image was drawn in the last frame (screen points).
+    image_rect: Option<egui::Rect>,
 }
 
 impl GlintApp {
@@ -133,7 +155,17 @@ impl GlintApp {
             (settings.width, settings.height) = (w, h);
         }
         let (octree, build_seconds) = build_octree(&scene);
-        Ok(Self {
+        let mut anti_aliasing = anti_aliasing;
+        match options.compare {
+            Some(CompareSetting::Octree) => settings.use_octree = !settings.use_octree,
+            Some(CompareSetting::AntiAliasing) => anti_aliasing = !anti_aliasing,
+            None => {}
+        }
+        let inspect = super::inspect::InspectState {
+            overlay_depth: options.overlay_depth,
+            ..Default::default()
+        };
+        let mut app = Self {
             camera: scene.camera,
             source,
             scene: Arc::new(scene),
@@ -149,12 +181,41 @@ impl GlintApp {
             dragging: false,
             messages: Vec::new(),
             commands: Vec::new(),
-            options,
             frames_since_final: 0,
             screenshot_requested: false,
             exit_requested: false,
             started: Instant::now(),
-        })
+            inspect,
+            compare_pending: options.compare,
+            image_rect: None,
+            options,
+        };
+        if let Some((i, j)) = app.options.inspect {
+            app.inspect_pixel(i, j);
+        }
+        Ok(app)
+    }
+
+    /// `--compare`: once A (the flipped setting) is complete, pin it and
+    /// flip the setting back, so B renders.
+    fn compare_logic(&mut self) {
+        let Some(setting) = self.compare_pending else {
+            return;
+        };
+        if !self.final_pass_shown() {
+            return;
+        }
+        self.pin_as_a();
+        if self.options.compare_difference
+            && let Some(c) = &mut self.inspect.compare
+        {
+            c.mode = super::inspect::CompareMode::Difference;
+        }
+        match setting {
+            CompareSetting::Octree => self.settings.use_octree = !self.settings.use_octree,
+            CompareSetting::AntiAliasing => self.anti_aliasing = !self.anti_aliasing,
+        }
+        self.compare_pending = None;
     }
 
     pub fn settings(&self) -> &RenderSettings {
@@ -180,6 +241,19 @@ impl GlintApp {
 
     pub fn camera(&self) -> &CameraSpec {
         &self.camera
+    }
+
+    /// Where the image was drawn in the last frame (screen points).
+    pub fn image_rect(&self) -> Option<egui::Rect> {
+        self.image_rect
+    }
+
+    pub fn inspection(&self) -> Option<&super::inspect::Inspection> {
+        self.inspect.inspection.as_ref()
+    }
+
+    pub fn compare(&self) -> Option<&super::inspect::Compare> {
+        self.inspect.compare.as_ref()
     }
 
     pub fn messages(&self) -> &[Message] {
@@ -379,27 +453,52 @@ impl GlintApp {
         }
     }
 
-    /// Saves the display buffer exactly as shown, through a temporary file.
+    /// Saves the display buffer as shown, with the record of how it was
+    /// made (see [`crate::export`]). A finished frame is written as
+    /// `glint render` writes it (the diagnostic views with their legend
+    /// strip); an unfinished one as the pixels on screen.
     pub fn export_to(&self, path: &Path) -> anyhow::Result<()> {
-        let (w, h, rgba) = self
-            .worker
-            .with_buffer(|b| (b.width, b.height, b.rgba.clone()));
+        let generation = self.worker.generation();
+        let (w, h, rgba, frame, pass) = self.worker.with_buffer(|b| {
+            let done = b.finished && b.generation == generation;
+            (
+                b.width,
+                b.height,
+                b.rgba.clone(),
+                b.last_frame.clone().filter(|_| done),
+                b.pass,
+            )
+        });
         anyhow::ensure!(w > 0 && h > 0, "nothing has been rendered yet");
-        let rgb: Vec<u8> = rgba
-            .chunks_exact(4)
-            .flat_map(|p| [p[0], p[1], p[2]])
-            .collect();
-        let image = image::RgbImage::from_raw(w, h, rgb)
-            .ok_or_else(|| anyhow::anyhow!("buffer size mismatch"))?;
-        let file_name = path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        let tmp = path.with_file_name(format!(".{file_name}.{}.tmp", std::process::id()));
-        image.save_with_format(&tmp, image::ImageFormat::Png)?;
-        if let Err(e) = std::fs::rename(&tmp, path) {
-            let _ = std::fs::remove_file(&tmp);
-            return Err(e.into());
+        let mut settings = self.settings;
+        (settings.width, settings.height) = (w, h);
+        settings.samples = if pass == Some(PassKind::SixteenSamples) {
+            16
+        } else {
+            1
+        };
+        let name = match &self.source {
+            SceneSource::BuiltIn => super::builtin::NAME.to_string(),
+            SceneSource::File(p) => p.display().to_string(),
+        };
+        let mut record = RenderRecord::new(&self.scene, &name, &self.camera, settings);
+        if self.scene_version > 0 {
+            record.settings.edits = Some(SceneEdits {
+                lights: self.scene.lights.clone(),
+                materials: self.scene.materials.clone(),
+            });
+        }
+        match frame {
+            Some(f) if f.width == w && f.height == h => {
+                crate::export::save_png(&f, path, Some(&record))?
+            }
+            _ => {
+                let rgb: Vec<u8> = rgba
+                    .chunks_exact(4)
+                    .flat_map(|p| [p[0], p[1], p[2]])
+                    .collect();
+                crate::export::save_rgb_png(path, w, h, &rgb, Some(&record))?
+            }
         }
         Ok(())
     }
@@ -438,7 +537,11 @@ impl GlintApp {
         }
         let (rect, response) = ui.allocate_exact_size(available, Sense::click_and_drag());
         let image_rect = egui::Rect::from_center_size(rect.center(), size);
-        match &self.texture {
+        self.image_rect = Some(image_rect);
+        let live = self.texture.clone();
+        let compared = self.compare_image_ui(ui, image_rect, live.as_ref());
+        match &live {
+            _ if compared => {}
             Some(t) => {
                 let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
                 ui.painter().image(t.id(), image_rect, uv, Color32::WHITE);
@@ -452,6 +555,17 @@ impl GlintApp {
                     ui.visuals().text_color(),
                 );
             }
+        }
+        self.overlays_ui(ui, image_rect);
+        // Inspect: Ctrl+click, or a click in inspect mode, picks a pixel.
+        if response.clicked()
+            && (self.inspect.inspect_mode || ui.input(|i| i.modifiers.command))
+            && let Some(pos) = response.interact_pointer_pos()
+            && image_rect.contains(pos)
+        {
+            let x = (pos.x - image_rect.min.x) / image_rect.width() * self.settings.width as f32;
+            let y = (pos.y - image_rect.min.y) / image_rect.height() * self.settings.height as f32;
+            self.inspect_pixel(x as u32, y as u32);
         }
         // Mouse: left orbits, right or middle pans, the wheel dollies.
         let delta = response.drag_delta();
@@ -501,6 +615,7 @@ impl GlintApp {
             .show(ui, |ui| super::panels::timing_ui(self, ui));
         egui::CentralPanel::default_margins().show(ui, |ui| self.image_ui(ui));
         self.apply_commands(&ctx);
+        self.compare_logic();
         self.sync_render();
         self.screenshot_logic(&ctx);
     }
@@ -514,7 +629,7 @@ impl GlintApp {
             ctx.request_repaint();
             return;
         }
-        if self.final_pass_shown() {
+        if self.compare_pending.is_none() && self.final_pass_shown() {
             if self.frames_since_final == 0 {
                 // Report the passes of the shown image: the measured time to
                 // the first and the final pass.

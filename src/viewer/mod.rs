@@ -3,6 +3,7 @@
 //! renders in the background.
 
 pub mod app;
+pub mod inspect;
 mod orbit;
 mod panels;
 pub mod worker;

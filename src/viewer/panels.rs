@@ -104,6 +104,10 @@ pub fn controls_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                 });
             });
 
+        egui::CollapsingHeader::new("Inspect and compare")
+            .default_open(true)
+            .show(ui, |ui| super::inspect::inspect_controls_ui(app, ui));
+
         egui::CollapsingHeader::new("Camera")
             .default_open(true)
             .show(ui, |ui| {
@@ -182,6 +186,47 @@ pub fn controls_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
 }
 
 pub fn timing_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
+    egui::ScrollArea::vertical().show(ui, |ui| {
+        timing_grid_ui(app, ui);
+        legend_ui(app, ui);
+        ui.separator();
+        ui.heading("Pixel");
+        super::inspect::ray_tree_ui(app, ui);
+    });
+}
+
+/// The colour scale of the cost and aa-need views, from the shown frame.
+fn legend_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
+    let legend = app
+        .worker()
+        .try_with_buffer(|b| b.last_frame.as_ref().and_then(|f| f.legend()))
+        .flatten();
+    let Some(legend) = legend else { return };
+    ui.separator();
+    ui.label(RichText::new(&legend.caption).strong());
+    let (rect, _) =
+        ui.allocate_exact_size(egui::vec2(ui.available_width(), 14.0), egui::Sense::hover());
+    let n = 64;
+    for k in 0..n {
+        let t = k as f64 / (n - 1) as f64;
+        let c = legend.ramp.color(t);
+        let x0 = rect.min.x + rect.width() * k as f32 / n as f32;
+        let x1 = rect.min.x + rect.width() * (k + 1) as f32 / n as f32;
+        ui.painter().rect_filled(
+            egui::Rect::from_min_max(egui::pos2(x0, rect.min.y), egui::pos2(x1 + 0.5, rect.max.y)),
+            0.0,
+            Color32::from_rgb(c[0], c[1], c[2]),
+        );
+    }
+    ui.horizontal(|ui| {
+        ui.label(&legend.low);
+        ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
+            ui.label(&legend.high);
+        });
+    });
+}
+
+fn timing_grid_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
     let history = app.worker().history();
     ui.heading("Timing");
     let last = |kind: PassKind| history.iter().rev().find(|r| r.kind == kind);
@@ -323,6 +368,10 @@ pub fn status_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
             None => {
                 ui.label("rendering…");
             }
+        }
+        if app.settings().view == ViewMode::AaNeed && !app.anti_aliasing() {
+            ui.separator();
+            ui.label("aa-need compares the 1- and 16-sample passes: turn anti-aliasing on");
         }
         if let Some(m) = app.messages().last() {
             ui.separator();

@@ -290,6 +290,13 @@ fn render_pass(
     last: bool,
 ) -> bool {
     let stale = || shared.generation.load(Ordering::SeqCst) != generation;
+    // The aa-need view renders shaded passes and shows their difference
+    // once the 16-sample pass is done.
+    let shown_view = settings.view;
+    let mut settings = settings;
+    if shown_view == ViewMode::AaNeed {
+        settings.view = ViewMode::Shaded;
+    }
     let Ok(renderer) = Renderer::with_camera(&job.scene, &job.octree, settings, &job.camera) else {
         return false;
     };
@@ -366,7 +373,6 @@ fn render_pass(
         view: settings.view,
         pixels,
     };
-    let rgba = rgb_to_rgba(&frame.to_rgb8());
     let one_sample_error = {
         let mut one = shared.one_sample.lock().unwrap_or_else(|e| e.into_inner());
         match kind {
@@ -381,6 +387,19 @@ fn render_pass(
             PassKind::Preview { .. } => None,
         }
     };
+    let frame = match (shown_view, kind) {
+        (ViewMode::AaNeed, PassKind::SixteenSamples) => {
+            let one = shared.one_sample.lock().unwrap_or_else(|e| e.into_inner());
+            match one.as_ref() {
+                Some((g, f)) if *g == generation && f.pixels.len() == frame.pixels.len() => {
+                    Frame::aa_need(f, &frame)
+                }
+                _ => frame,
+            }
+        }
+        _ => frame,
+    };
+    let rgba = rgb_to_rgba(&frame.to_rgb8());
     {
         let mut b = shared.buffer.lock().unwrap_or_else(|e| e.into_inner());
         if b.generation != generation {
@@ -427,9 +446,30 @@ fn count_tile(shared: &Shared, generation: u64) {
 }
 
 /// Display bytes of one tile. Depth is normalised by the nearest distance
-/// seen so far; the finished pass replaces it with the exact full frame.
+/// seen so far, cost by the range seen so far; the finished pass replaces
+/// them with the exact full frame.
 fn tile_rgba(values: &[DVec3], view: ViewMode, depth_range: &Mutex<(f64, f64)>) -> Vec<u8> {
     let rgb = match view {
+        ViewMode::Cost | ViewMode::CostSteps => {
+            let range = {
+                let mut r = depth_range.lock().unwrap_or_else(|e| e.into_inner());
+                for v in values {
+                    let c = crate::render::cost_value(*v, view);
+                    r.0 = r.0.min(c);
+                    r.1 = r.1.max(c);
+                }
+                *r
+            };
+            values
+                .iter()
+                .flat_map(|v| {
+                    crate::legend::viridis(crate::render::cost_shade(
+                        crate::render::cost_value(*v, view),
+                        range,
+                    ))
+                })
+                .collect()
+        }
         ViewMode::Depth => {
             let near = {
                 let mut r = depth_range.lock().unwrap_or_else(|e| e.into_inner());

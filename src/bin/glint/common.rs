@@ -50,6 +50,19 @@ pub fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
     Ok((parse_positive(w)?, parse_positive(h)?))
 }
 
+/// `X,Y` pixel coordinates.
+pub fn parse_pixel(s: &str) -> std::result::Result<(u32, u32), String> {
+    let (x, y) = s
+        .split_once(',')
+        .ok_or_else(|| format!("expected X,Y, got `{s}`"))?;
+    let n = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("expected X,Y as whole numbers, got `{s}`"))
+    };
+    Ok((n(x)?, n(y)?))
+}
+
 pub fn parse_positive(s: &str) -> std::result::Result<u32, String> {
     match s.parse::<u32>() {
         Ok(n) if n > 0 => Ok(n),

@@ -10,7 +10,9 @@ use glint::render::{RenderSettings, Renderer, ViewMode};
 use glint::stats::RayCounts;
 use serde::Serialize;
 
-use crate::common::{OctreeArgs, Switch, load_scene, parse_positive, parse_samples, thread_pool};
+use crate::common::{
+    OctreeArgs, Switch, load_scene, parse_pixel, parse_positive, parse_samples, thread_pool,
+};
 
 #[derive(clap::Args)]
 pub struct RenderArgs {
@@ -70,18 +72,6 @@ pub struct RenderArgs {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum OverlayKind {
     Octree,
-}
-
-fn parse_pixel(s: &str) -> std::result::Result<(u32, u32), String> {
-    let (x, y) = s
-        .split_once(',')
-        .ok_or_else(|| format!("expected X,Y, got `{s}`"))?;
-    let n = |v: &str| {
-        v.trim()
-            .parse::<u32>()
-            .map_err(|_| format!("expected X,Y as whole numbers, got `{s}`"))
-    };
-    Ok((n(x)?, n(y)?))
 }
 
 /// The `--trace-pixel` object (schema in README, "A pixel's ray tree").

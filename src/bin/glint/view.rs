@@ -4,9 +4,10 @@ use std::path::PathBuf;
 
 use anyhow::{Result, anyhow};
 use glint::render::ViewMode;
+use glint::viewer::app::CompareSetting;
 use glint::viewer::{GlintApp, SceneSource, ViewerOptions};
 
-use crate::common::{Switch, parse_size};
+use crate::common::{Switch, parse_pixel, parse_size};
 
 #[derive(clap::Args)]
 pub struct ViewArgs {
@@ -37,6 +38,25 @@ pub struct ViewArgs {
     /// Window size as WIDTHxHEIGHT in points.
     #[arg(long, default_value = "1400x860")]
     pub window: String,
+    /// Start with the octree overlay drawn down to this level.
+    #[arg(long, value_name = "DEPTH")]
+    pub overlay_depth: Option<u32>,
+    /// Start with pixel X,Y's ray tree inspected (from the top-left, from 0).
+    #[arg(long, value_name = "X,Y", value_parser = parse_pixel)]
+    pub inspect: Option<(u32, u32)>,
+    /// Start with an A/B comparison: A is rendered with this setting
+    /// flipped and pinned, then B renders as given.
+    #[arg(long, value_enum)]
+    pub compare: Option<CompareArg>,
+    /// Show the comparison as |A - B| instead of a split.
+    #[arg(long)]
+    pub compare_difference: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum CompareArg {
+    Octree,
+    Aa,
 }
 
 impl Default for ViewArgs {
@@ -52,6 +72,10 @@ impl Default for ViewArgs {
             threads: 0,
             size: None,
             window: "1400x860".into(),
+            overlay_depth: None,
+            inspect: None,
+            compare: None,
+            compare_difference: false,
         }
     }
 }
@@ -76,6 +100,13 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         octree: args.octree.map(Switch::is_on),
         anti_aliasing: args.aa.map(Switch::is_on),
         size: args.size,
+        overlay_depth: args.overlay_depth,
+        inspect: args.inspect,
+        compare: args.compare.map(|c| match c {
+            CompareArg::Octree => CompareSetting::Octree,
+            CompareArg::Aa => CompareSetting::AntiAliasing,
+        }),
+        compare_difference: args.compare_difference,
     };
     let native = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
