@@ -121,6 +121,16 @@ struct RenderStats {
     dropped_degenerate_triangles: usize,
     #[serde(skip_serializing_if = "Option::is_none")]
     octree_stats: Option<OctreeStats>,
+    /// With `--view cost` or `cost-steps`: the per-pixel count's range.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    cost_per_pixel: Option<CostJson>,
+}
+
+#[derive(Serialize)]
+struct CostJson {
+    min: f64,
+    max: f64,
+    mean: f64,
 }
 
 #[derive(Serialize)]
@@ -274,6 +284,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             nonfinite_samples: counts.nonfinite_samples,
             dropped_degenerate_triangles: scene.dropped_triangles,
             octree_stats: settings.use_octree.then(|| octree.stats()),
+            cost_per_pixel: frame.cost_summary().map(|c| CostJson {
+                min: c.min,
+                max: c.max,
+                mean: c.mean,
+            }),
         };
         println!("{}", serde_json::to_string_pretty(&stats)?);
     }
