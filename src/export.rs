@@ -111,14 +111,14 @@ impl RenderRecord {
 
 #[derive(Debug, thiserror::Error)]
 pub enum ExportError {
-    #[error("cannot write {path}: {source}")]
+    #[error("cannot write {path}")]
     Write {
         path: PathBuf,
         source: std::io::Error,
     },
     #[error("cannot encode {path} as PNG: {message}")]
     Encode { path: PathBuf, message: String },
-    #[error("cannot read {path}: {source}")]
+    #[error("cannot read {path}")]
     Read {
         path: PathBuf,
         source: std::io::Error,
@@ -174,12 +174,25 @@ pub fn save_rgb_png(
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     let tmp = path.with_file_name(format!(".{file_name}.{}.tmp", std::process::id()));
-    let result = write_png(&tmp, width, height, rgb, record).and_then(|()| {
-        std::fs::rename(&tmp, path).map_err(|source| ExportError::Write {
-            path: path.to_owned(),
-            source,
+    // Errors name the file the user asked for, not the temporary one.
+    let result = write_png(&tmp, width, height, rgb, record)
+        .map_err(|e| match e {
+            ExportError::Write { source, .. } => ExportError::Write {
+                path: path.to_owned(),
+                source,
+            },
+            ExportError::Encode { message, .. } => ExportError::Encode {
+                path: path.to_owned(),
+                message,
+            },
+            other => other,
         })
-    });
+        .and_then(|()| {
+            std::fs::rename(&tmp, path).map_err(|source| ExportError::Write {
+                path: path.to_owned(),
+                source,
+            })
+        });
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }

@@ -76,12 +76,10 @@ fn clip(p: (f64, f64), q: (f64, f64), w: f64, h: f64) -> Option<((f64, f64), (f6
             }
         }
     }
-    (t0 <= t1 && t0.is_finite() && t1.is_finite()).then(|| {
-        (
-            (p.0 + t0 * dx, p.1 + t0 * dy),
-            (p.0 + t1 * dx, p.1 + t1 * dy),
-        )
-    })
+    (t0 <= t1 && t0.is_finite() && t1.is_finite()).then_some((
+        (p.0 + t0 * dx, p.1 + t0 * dy),
+        (p.0 + t1 * dx, p.1 + t1 * dy),
+    ))
 }
 
 /// Draws `cells` as wireframe boxes into an RGB8 image the camera's size.
