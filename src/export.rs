@@ -45,6 +45,10 @@ pub struct RecordedSettings {
     /// file's (absent when they are the file's own).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub edits: Option<SceneEdits>,
+    /// Exported from the viewer while a pass was still sweeping in: the
+    /// pixels are part old, part new, and a re-render gives the whole pass.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub partial: bool,
 }
 
 /// Lights and materials that replace a scene file's own.
@@ -104,6 +108,7 @@ impl RenderRecord {
                 octree_params: scene.octree_params,
                 overlay_depth: None,
                 edits: None,
+                partial: false,
             },
         }
     }
@@ -255,15 +260,12 @@ pub fn read_record(path: &Path) -> Result<RenderRecord, ExportError> {
         path: path.to_owned(),
         message,
     };
-    let mut reader = png::Decoder::new(std::io::BufReader::new(file))
+    // glint writes its text chunks before the image data, so reading the
+    // header chunks is enough: the pixels are never decoded (a crafted
+    // header cannot make this allocate).
+    let reader = png::Decoder::new(std::io::BufReader::new(file))
         .read_info()
         .map_err(|e| decode(e.to_string()))?;
-    // Text chunks after the image data appear only once it has been read.
-    let mut pixels = vec![0; reader.output_buffer_size().unwrap_or(0)];
-    reader
-        .next_frame(&mut pixels)
-        .map_err(|e| decode(e.to_string()))?;
-    let _ = reader.finish();
     let info = reader.info();
     let text = |key: &'static str| -> Result<String, ExportError> {
         let chunk = info
@@ -294,6 +296,11 @@ pub fn read_record(path: &Path) -> Result<RenderRecord, ExportError> {
         scene_text: text(KEY_SCENE)?,
         settings,
     };
+    validate(&record.settings).map_err(|message| ExportError::Malformed {
+        path: path.to_owned(),
+        key: KEY_SETTINGS,
+        message,
+    })?;
     let computed = crate::sha256::sha256_hex(record.scene_text.as_bytes());
     if computed != record.scene_sha256 {
         return Err(ExportError::Checksum {
@@ -303,6 +310,59 @@ pub fn read_record(path: &Path) -> Result<RenderRecord, ExportError> {
         });
     }
     Ok(record)
+}
+
+/// The limits scene files and the command line enforce, applied to a
+/// record (a PNG is user input like any other).
+fn validate(s: &RecordedSettings) -> Result<(), String> {
+    let r = &s.render;
+    if !(1..=crate::scene::toml_format::MAX_DEPTH_LIMIT as u32).contains(&r.max_depth) {
+        return Err(format!("max_depth {} is outside 1..=64", r.max_depth));
+    }
+    if s.octree_params.max_depth > crate::accel::MAX_OCTREE_DEPTH {
+        return Err(format!(
+            "octree max_depth {} is above {}",
+            s.octree_params.max_depth,
+            crate::accel::MAX_OCTREE_DEPTH
+        ));
+    }
+    if s.octree_params.leaf_size == 0 {
+        return Err("octree leaf_size must be at least 1".into());
+    }
+    if r.width == 0 || r.height == 0 || r.width as u64 * r.height as u64 > 1 << 28 {
+        return Err(format!(
+            "image size {}x{} is not allowed",
+            r.width, r.height
+        ));
+    }
+    if s.overlay_depth
+        .is_some_and(|d| d > crate::accel::MAX_OCTREE_DEPTH)
+    {
+        return Err("overlay depth is above the octree's limit".into());
+    }
+    if let Some(e) = &s.edits {
+        let finite = |v: DVec3| v.is_finite();
+        for (i, l) in e.lights.iter().enumerate() {
+            if !finite(l.position) || !finite(l.color) {
+                return Err(format!("light {i} has a non-finite value"));
+            }
+        }
+        for m in &e.materials {
+            let values = [
+                m.ka,
+                m.kd,
+                m.ks,
+                m.shininess,
+                m.reflectivity,
+                m.transparency,
+                m.ior,
+            ];
+            if !finite(m.color) || values.iter().any(|v| !v.is_finite()) || m.ior <= 0.0 {
+                return Err(format!("material `{}` has an invalid value", m.name));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The scene a record was made from: parsed from its embedded text, with

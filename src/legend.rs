@@ -72,7 +72,7 @@ fn text_scale(width: u32, legend: &Legend) -> u32 {
 pub fn append_legend(rgb: &mut Vec<u8>, width: u32, height: u32, legend: &Legend) -> u32 {
     let strip = legend_height(width, legend);
     let new_height = height + strip;
-    rgb.resize((width * new_height * 3) as usize, 0);
+    rgb.resize(width as usize * new_height as usize * 3, 0);
     let mut canvas = Canvas {
         rgb,
         width,
@@ -112,7 +112,7 @@ impl Canvas<'_> {
     fn fill(&mut self, x: u32, y: u32, w: u32, h: u32, c: [u8; 3]) {
         for yy in y..(y + h).min(self.height) {
             for xx in x..(x + w).min(self.width) {
-                let i = ((yy * self.width + xx) * 3) as usize;
+                let i = (yy as usize * self.width as usize + xx as usize) * 3;
                 self.rgb[i..i + 3].copy_from_slice(&c);
             }
         }

@@ -224,6 +224,15 @@ fn pin_as_a_then_octree_off_reads_zero_pixels_differ() {
     assert!(!h.state().settings().use_octree);
     settle(&mut h);
     let stats = h.state().compare_stats().expect("A and B compared");
+    let generation = h.state().worker().generation();
+    assert!(
+        h.state()
+            .worker()
+            .history()
+            .iter()
+            .any(|r| r.generation == generation && !r.octree),
+        "B is a finished pass with the octree off"
+    );
     assert_eq!(stats.differing, 0, "octree on vs off: {stats:?}");
     assert_eq!(stats.total, 64 * 48);
     h.get_by_label_contains("0 pixels differ of 3072");
@@ -310,36 +319,73 @@ fn clicking_in_inspect_mode_picks_the_pixel_and_its_ray_tree() {
 }
 
 #[test]
-fn a_viewer_export_renders_again_identically_from_its_metadata() {
+fn viewer_exports_render_again_identically_from_their_metadata() {
+    use glint::render::ViewMode;
+    let dir = std::env::temp_dir().join(format!("glint-viewer-export-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (first, again) = (dir.join("first.png"), dir.join("again.png"));
     let mut h = harness(small_app());
     settle(&mut h);
-    // An edit made in the window must travel with the export.
+    let unedited = h.state().worker().with_buffer(|b| b.rgba.clone());
+    // Edits made in the window travel with the export.
     h.state_mut().scene_mut().materials[0].color = glint::math::DVec3::new(0.9, 0.1, 0.6);
     h.state_mut().scene_mut().lights[0].position.y += 2.0;
     h.run_steps(2);
     settle(&mut h);
-    let dir = std::env::temp_dir().join(format!("glint-viewer-export-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let (first, again) = (dir.join("first.png"), dir.join("again.png"));
-    h.state().export_to(&first).unwrap();
-    let record = glint::export::read_record(&first).unwrap();
-    assert!(record.settings.edits.is_some(), "edits are recorded");
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_glint"))
-        .args(["render", "--from-png"])
-        .arg(&first)
-        .arg("-o")
-        .arg(&again)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    assert_ne!(
+        h.state().worker().with_buffer(|b| b.rgba.clone()),
+        unedited,
+        "the edit shows in the image"
     );
-    let a = image::open(&first).unwrap().to_rgb8();
-    let b = image::open(&again).unwrap().to_rgb8();
-    assert_eq!(a.dimensions(), b.dimensions());
-    let (n, largest) = common::diff(a.as_raw(), b.as_raw(), 0);
-    assert_eq!(n, 0, "{n} pixels differ (largest {largest})");
+    // Shaded with edits, then a diagnostic view, aa-need without
+    // anti-aliasing (a shaded frame), and the octree overlay.
+    type Setup = Box<dyn Fn(&mut GlintApp)>;
+    let cases: [(&str, Setup); 4] = [
+        ("shaded, edited", Box::new(|_| {})),
+        ("cost", Box::new(|a| a.settings_mut().view = ViewMode::Cost)),
+        (
+            "aa-need, AA off",
+            Box::new(|a| {
+                a.settings_mut().view = ViewMode::AaNeed;
+                a.set_anti_aliasing(false);
+            }),
+        ),
+        (
+            "overlay",
+            Box::new(|a| {
+                a.settings_mut().view = ViewMode::Shaded;
+                a.set_overlay_depth(Some(2));
+            }),
+        ),
+    ];
+    for (name, setup) in cases {
+        setup(h.state_mut());
+        h.run_steps(2);
+        settle(&mut h);
+        h.state().export_to(&first).unwrap();
+        let record = glint::export::read_record(&first).unwrap();
+        assert!(
+            record.settings.edits.is_some(),
+            "{name}: edits are recorded"
+        );
+        assert!(!record.settings.partial, "{name}: a finished pass");
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_glint"))
+            .args(["render", "--from-png"])
+            .arg(&first)
+            .arg("-o")
+            .arg(&again)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let a = image::open(&first).unwrap().to_rgb8();
+        let b = image::open(&again).unwrap().to_rgb8();
+        assert_eq!(a.dimensions(), b.dimensions(), "{name}");
+        let (n, largest) = common::diff(a.as_raw(), b.as_raw(), 0);
+        assert_eq!(n, 0, "{name}: {n} pixels differ (largest {largest})");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -231,6 +231,17 @@ impl GlintApp {
         self.anti_aliasing
     }
 
+    /// Turns the 16-sample pass on or off; a change restarts the passes.
+    pub fn set_anti_aliasing(&mut self, on: bool) {
+        self.anti_aliasing = on;
+    }
+
+    /// Shows the octree overlay down to `depth`, or hides it (`None`);
+    /// display-only, nothing is re-rendered.
+    pub fn set_overlay_depth(&mut self, depth: Option<u32>) {
+        self.inspect.overlay_depth = depth;
+    }
+
     pub fn worker(&self) -> &Worker {
         &self.worker
     }
@@ -453,46 +464,52 @@ impl GlintApp {
         }
     }
 
-    /// Saves the display buffer as shown, with the record of how it was
-    /// made (see [`crate::export`]). A finished frame is written as
-    /// `glint render` writes it (the diagnostic views with their legend
-    /// strip); an unfinished one as the pixels on screen.
+    /// Saves the display buffer with the record of how it was made (see
+    /// [`crate::export`]): the scene, camera and settings of the pass on
+    /// screen, not the panels' current values. A finished pass is written
+    /// as `glint render` writes it (diagnostic views with their legend
+    /// strip, the octree overlay drawn in when it is shown); a pass still
+    /// sweeping in is written as displayed and recorded as partial.
     pub fn export_to(&self, path: &Path) -> anyhow::Result<()> {
-        let generation = self.worker.generation();
-        let (w, h, rgba, frame, pass) = self.worker.with_buffer(|b| {
-            let done = b.finished && b.generation == generation;
+        let (w, h, rgba, frame, source, finished) = self.worker.with_buffer(|b| {
             (
                 b.width,
                 b.height,
                 b.rgba.clone(),
-                b.last_frame.clone().filter(|_| done),
-                b.pass,
+                b.last_frame.clone(),
+                b.source.clone(),
+                b.finished,
             )
         });
         anyhow::ensure!(w > 0 && h > 0, "nothing has been rendered yet");
-        let mut settings = self.settings;
-        (settings.width, settings.height) = (w, h);
-        settings.samples = if pass == Some(PassKind::SixteenSamples) {
-            16
-        } else {
-            1
+        let Some(source) = source else {
+            anyhow::bail!("nothing has been rendered yet");
         };
         let name = match &self.source {
             SceneSource::BuiltIn => super::builtin::NAME.to_string(),
             SceneSource::File(p) => p.display().to_string(),
         };
-        let mut record = RenderRecord::new(&self.scene, &name, &self.camera, settings);
-        if self.scene_version > 0 {
-            record.settings.edits = Some(SceneEdits {
-                lights: self.scene.lights.clone(),
-                materials: self.scene.materials.clone(),
-            });
-        }
+        let mut record = RenderRecord::new(&source.scene, &name, &source.camera, source.settings);
+        // Lights and materials as rendered (the panels may have edited them).
+        record.settings.edits = Some(SceneEdits {
+            lights: source.scene.lights.clone(),
+            materials: source.scene.materials.clone(),
+        });
         match frame {
-            Some(f) if f.width == w && f.height == h => {
-                crate::export::save_png(&f, path, Some(&record))?
+            Some(f) if finished && f.width == w && f.height == h => {
+                match self.inspect.overlay_depth {
+                    Some(depth) => {
+                        record.settings.overlay_depth = Some(depth);
+                        let camera = crate::camera::Camera::new(&source.camera, w, h)?;
+                        let cells = self.octree.cells(depth);
+                        let (rgb, height) = crate::overlay::annotate(&f, &camera, &cells, depth);
+                        crate::export::save_rgb_png(path, w, height, &rgb, Some(&record))?
+                    }
+                    None => crate::export::save_png(&f, path, Some(&record))?,
+                }
             }
             _ => {
+                record.settings.partial = true;
                 let rgb: Vec<u8> = rgba
                     .chunks_exact(4)
                     .flat_map(|p| [p[0], p[1], p[2]])

@@ -73,6 +73,8 @@ pub struct Compare {
     pub gain: f32,
     texture: Option<TextureHandle>,
     diff_texture: Option<(u64, u32, TextureHandle)>,
+    /// The last comparison, by buffer version: counted once per change.
+    stats: std::cell::Cell<Option<(u64, Option<DiffStats>)>>,
 }
 
 /// Run-time state of the inspection tools (none of it restarts a render).
@@ -168,6 +170,7 @@ impl GlintApp {
             gain: 8.0,
             texture: None,
             diff_texture: None,
+            stats: std::cell::Cell::new(None),
         });
     }
 
@@ -203,13 +206,22 @@ impl GlintApp {
     pub fn compare_stats(&self) -> Option<DiffStats> {
         let c = self.inspect.compare.as_ref()?;
         let generation = self.worker.generation();
-        self.worker.with_buffer(|b| {
-            (b.finished
+        let cached = c.stats.get();
+        let result = self.worker.with_buffer(|b| {
+            if let Some((version, stats)) = cached
+                && version == b.version
+            {
+                return (version, stats);
+            }
+            let stats = (b.finished
                 && b.generation == generation
                 && b.width == c.pinned.width
                 && b.height == c.pinned.height)
-                .then(|| diff_stats(&c.pinned.rgba, &b.rgba))
-        })
+                .then(|| diff_stats(&c.pinned.rgba, &b.rgba));
+            (b.version, stats)
+        });
+        c.stats.set(Some(result));
+        result.1
     }
 
     /// Draws A over the live image (split or difference) where a comparison
@@ -304,13 +316,20 @@ impl GlintApp {
                 }
             }
             CompareMode::Difference => {
-                let (version, rgba) = self.worker.with_buffer(|b| (b.version, b.rgba.clone()));
+                // Size and pixels under one lock, copied only when they
+                // changed; a busy buffer is simply tried again next frame.
                 let gain_key = c.gain.to_bits();
-                let stale = c
-                    .diff_texture
-                    .as_ref()
-                    .is_none_or(|(v, g, _)| *v != version || *g != gain_key);
-                if stale {
+                let cached = c.diff_texture.as_ref().map(|(v, g, _)| (*v, *g));
+                let fresh = self
+                    .worker
+                    .try_with_buffer(|b| {
+                        let size_ok = (b.width, b.height) == (c.pinned.width, c.pinned.height)
+                            && b.rgba.len() == c.pinned.rgba.len();
+                        (size_ok && cached != Some((b.version, gain_key)))
+                            .then(|| (b.version, b.rgba.clone()))
+                    })
+                    .flatten();
+                if let Some((version, rgba)) = fresh {
                     let diff: Vec<u8> = c
                         .pinned
                         .rgba

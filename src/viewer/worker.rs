@@ -89,6 +89,26 @@ pub struct DisplayBuffer {
     pub finished: bool,
     /// The linear-light frame of the last completed pass (for exact comparisons).
     pub last_frame: Option<Frame>,
+    /// What the pass on screen renders: scene, camera and settings (its
+    /// size, samples and the view its frame holds), for export records.
+    pub source: Option<FrameSource>,
+}
+
+/// The inputs of a pass, exactly as rendered.
+#[derive(Clone)]
+pub struct FrameSource {
+    pub scene: Arc<Scene>,
+    pub camera: CameraSpec,
+    pub settings: RenderSettings,
+}
+
+impl std::fmt::Debug for FrameSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FrameSource")
+            .field("camera", &self.camera)
+            .field("settings", &self.settings)
+            .finish_non_exhaustive()
+    }
 }
 
 /// The 1-sample frame of the generation being refined, kept by the worker
@@ -316,6 +336,21 @@ fn render_pass(
         }
         b.generation = generation;
         b.pass = Some(kind);
+        // The aa-need difference exists only after a 16-sample pass; before
+        // it (and without anti-aliasing) the frame is the shaded picture.
+        let frame_view = if shown_view == ViewMode::AaNeed && kind != PassKind::SixteenSamples {
+            ViewMode::Shaded
+        } else {
+            shown_view
+        };
+        b.source = Some(FrameSource {
+            scene: Arc::clone(&job.scene),
+            camera: job.camera,
+            settings: RenderSettings {
+                view: frame_view,
+                ..settings
+            },
+        });
         b.tiles_done = 0;
         b.tiles_total = all.len() as u64;
         b.finished = false;

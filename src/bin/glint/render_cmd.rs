@@ -64,9 +64,9 @@ pub struct RenderArgs {
     #[arg(long, value_enum)]
     pub overlay: Option<OverlayKind>,
     /// Deepest octree level the overlay draws (deeper subtrees are drawn
-    /// as one box at this level).
-    #[arg(long, default_value_t = 4)]
-    pub overlay_depth: u32,
+    /// as one box at this level). Default 4, or the recorded one with --from-png.
+    #[arg(long)]
+    pub overlay_depth: Option<u32>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -142,7 +142,7 @@ struct RaysJson {
 
 pub fn run(args: &RenderArgs) -> Result<()> {
     let load_start = Instant::now();
-    let mut overlay_depth = args.overlay.map(|_| args.overlay_depth);
+    let mut overlay_depth = args.overlay.map(|_| args.overlay_depth.unwrap_or(4));
     let (mut scene, scene_name, mut settings, camera) = match (&args.from_png, &args.scene) {
         (Some(png), _) => {
             let record = glint::export::read_record(png)?;
@@ -157,7 +157,17 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             let scene = glint::export::load_recorded_scene(&record)
                 .with_context(|| format!("cannot load the scene recorded in {}", png.display()))?;
             let settings = record.settings.render;
-            overlay_depth = overlay_depth.or(record.settings.overlay_depth);
+            overlay_depth = record
+                .settings
+                .overlay_depth
+                .map(|d| args.overlay_depth.unwrap_or(d))
+                .or(overlay_depth);
+            if record.settings.partial {
+                eprintln!(
+                    "note: {} was exported while a pass was still rendering; this renders the whole pass",
+                    png.display()
+                );
+            }
             (
                 scene,
                 record.scene_path.clone(),
