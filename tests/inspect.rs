@@ -392,3 +392,43 @@ fn trace_pixel_prints_the_tree_as_json() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("outside the 48x36 image"));
 }
+
+#[test]
+fn records_outside_the_limits_are_refused() {
+    let scene = common::load("scenes/sphere.toml");
+    let settings = RenderSettings::from_scene(&scene);
+    let dir = std::env::temp_dir().join(format!("glint-bad-record-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("bad.png");
+    let base =
+        glint::export::RenderRecord::new(&scene, "scenes/sphere.toml", &scene.camera, settings);
+    let cases: [(&str, Box<dyn Fn(&mut glint::export::RenderRecord)>); 4] = [
+        (
+            "leaf_size",
+            Box::new(|r| r.settings.octree_params.leaf_size = 0),
+        ),
+        (
+            "octree max_depth",
+            Box::new(|r| r.settings.octree_params.max_depth = 1_000_000),
+        ),
+        (
+            "max_depth",
+            Box::new(|r| r.settings.render.max_depth = 100_000),
+        ),
+        ("image size", Box::new(|r| r.settings.render.width = 0)),
+    ];
+    for (what, spoil) in cases {
+        let mut record = base.clone();
+        spoil(&mut record);
+        glint::export::save_rgb_png(&path, 1, 1, &[0, 0, 0], Some(&record)).unwrap();
+        let err = glint::export::read_record(&path).unwrap_err().to_string();
+        assert!(
+            err.contains("glint:settings") && err.contains("bad.png"),
+            "{what}: {err}"
+        );
+    }
+    // An untouched record reads back equal.
+    glint::export::save_rgb_png(&path, 1, 1, &[0, 0, 0], Some(&base)).unwrap();
+    assert_eq!(glint::export::read_record(&path).unwrap(), base);
+    let _ = std::fs::remove_dir_all(&dir);
+}
