@@ -316,6 +316,15 @@ fn clicking_in_inspect_mode_picks_the_pixel_and_its_ray_tree() {
         "a click does not move the camera"
     );
     h.get_by_label_contains("pixel 40,30");
+    // An edit traces the inspected pixel again: the tree follows the scene.
+    let before = h.state().inspection().unwrap().tree.clone();
+    for m in &mut h.state_mut().scene_mut().materials {
+        m.color *= 0.5;
+    }
+    h.run_steps(2);
+    let after = &h.state().inspection().expect("still inspected").tree;
+    assert_eq!(h.state().inspection().unwrap().pixel, (40, 30));
+    assert_ne!(*after, before, "the material's change shows in the tree");
 }
 
 #[test]

@@ -328,6 +328,12 @@ impl GlintApp {
             preview_divisor: inputs.preview_divisor,
         });
         self.submitted = Some(inputs);
+        // The inspected pixel follows the change: its rays are traced again
+        // (one pixel, a few microseconds) so the panel never shows a stale tree.
+        if let Some((i, j)) = self.inspect.inspection.as_ref().map(|ins| ins.pixel) {
+            self.inspect.inspection = None;
+            self.inspect_pixel(i, j);
+        }
     }
 
     /// Uploads the display buffer to the texture if new tiles arrived.
