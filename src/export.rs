@@ -179,32 +179,21 @@ pub fn save_rgb_png(
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     let tmp = path.with_file_name(format!(".{file_name}.{}.tmp", std::process::id()));
-    // Errors name the file the user asked for, not the temporary one.
-    let result = write_png(&tmp, width, height, rgb, record)
-        .map_err(|e| match e {
-            ExportError::Write { source, .. } => ExportError::Write {
-                path: path.to_owned(),
-                source,
-            },
-            ExportError::Encode { message, .. } => ExportError::Encode {
-                path: path.to_owned(),
-                message,
-            },
-            other => other,
+    let result = write_png(&tmp, path, width, height, rgb, record).and_then(|()| {
+        std::fs::rename(&tmp, path).map_err(|source| ExportError::Write {
+            path: path.to_owned(),
+            source,
         })
-        .and_then(|()| {
-            std::fs::rename(&tmp, path).map_err(|source| ExportError::Write {
-                path: path.to_owned(),
-                source,
-            })
-        });
+    });
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
     result
 }
 
+/// Writes to `tmp`; errors name `path`, the file the user asked for.
 fn write_png(
+    tmp: &Path,
     path: &Path,
     width: u32,
     height: u32,
@@ -215,7 +204,7 @@ fn write_png(
         path: path.to_owned(),
         message: e.to_string(),
     };
-    let file = std::fs::File::create(path).map_err(|source| ExportError::Write {
+    let file = std::fs::File::create(tmp).map_err(|source| ExportError::Write {
         path: path.to_owned(),
         source,
     })?;

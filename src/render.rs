@@ -584,27 +584,37 @@ impl<'a> Renderer<'a> {
                 r
             })
             .collect();
-        let mut pixels = vec![DVec3::ZERO; (w * h) as usize];
-        let mut counts = TileCounts::default();
-        for (tile, (values, c)) in all.iter().zip(results) {
-            counts += c;
-            for row in 0..tile.height {
-                let start = ((tile.y + row) * w + tile.x) as usize;
-                let src = (row * tile.width) as usize;
-                pixels[start..start + tile.width as usize]
-                    .copy_from_slice(&values[src..src + tile.width as usize]);
-            }
-        }
-        (
-            Frame {
-                width: w,
-                height: h,
-                view: self.settings.view,
-                pixels,
-            },
-            counts,
-        )
+        assemble_tiles(w, h, self.settings.view, &all, results)
     }
+}
+
+/// Puts rendered tiles together into a frame, summing their counts in tile
+/// order (so totals never depend on the thread schedule).
+pub fn assemble_tiles(
+    width: u32,
+    height: u32,
+    view: ViewMode,
+    tiles: &[Tile],
+    results: impl IntoIterator<Item = (Vec<DVec3>, TileCounts)>,
+) -> (Frame, TileCounts) {
+    let mut pixels = vec![DVec3::ZERO; (width * height) as usize];
+    let mut counts = TileCounts::default();
+    for (tile, (values, c)) in tiles.iter().zip(results) {
+        counts += c;
+        for row in 0..tile.height {
+            let start = ((tile.y + row) * width + tile.x) as usize;
+            let src = (row * tile.width) as usize;
+            pixels[start..start + tile.width as usize]
+                .copy_from_slice(&values[src..src + tile.width as usize]);
+        }
+    }
+    let frame = Frame {
+        width,
+        height,
+        view,
+        pixels,
+    };
+    (frame, counts)
 }
 
 /// Renders `settings.view` seen from `camera`, including the composite

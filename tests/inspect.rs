@@ -282,11 +282,6 @@ fn glint() -> Command {
     Command::new(env!("CARGO_BIN_EXE_glint"))
 }
 
-fn decode(path: &Path) -> (u32, u32, Vec<u8>) {
-    let img = image::open(path).unwrap().to_rgb8();
-    (img.width(), img.height(), img.into_raw())
-}
-
 #[test]
 fn exports_record_how_they_were_made_and_render_again_identically() {
     let dir = std::env::temp_dir().join(format!("glint-export-{}", std::process::id()));
@@ -326,21 +321,7 @@ fn exports_record_how_they_were_made_and_render_again_identically() {
             glint::sha256::sha256_hex(text.as_bytes())
         );
 
-        let out = glint()
-            .args(["render", "--from-png"])
-            .arg(&first)
-            .arg("-o")
-            .arg(&again)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let (a, b) = (decode(&first), decode(&again));
-        assert_eq!((a.0, a.1), (b.0, b.1));
-        let (n, largest) = common::diff(&a.2, &b.2, 0);
+        let (n, largest) = common::rerender_from_png(&first, &again);
         assert_eq!(n, 0, "{view}: {n} pixels differ (largest {largest})");
     }
 

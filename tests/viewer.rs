@@ -378,22 +378,7 @@ fn viewer_exports_render_again_identically_from_their_metadata() {
             "{name}: edits are recorded"
         );
         assert!(!record.settings.partial, "{name}: a finished pass");
-        let out = std::process::Command::new(env!("CARGO_BIN_EXE_glint"))
-            .args(["render", "--from-png"])
-            .arg(&first)
-            .arg("-o")
-            .arg(&again)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{name}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let a = image::open(&first).unwrap().to_rgb8();
-        let b = image::open(&again).unwrap().to_rgb8();
-        assert_eq!(a.dimensions(), b.dimensions(), "{name}");
-        let (n, largest) = common::diff(a.as_raw(), b.as_raw(), 0);
+        let (n, largest) = common::rerender_from_png(&first, &again);
         assert_eq!(n, 0, "{name}: {n} pixels differ (largest {largest})");
     }
     let _ = std::fs::remove_dir_all(&dir);

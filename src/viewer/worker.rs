@@ -391,23 +391,8 @@ fn render_pass(
     }
     let seconds = start.elapsed().as_secs_f64();
     // Assemble the exact frame, as `glint render` would, and publish it.
-    let mut pixels = vec![DVec3::ZERO; (w * h) as usize];
-    let mut counts = TileCounts::default();
-    for (tile, (values, c)) in all.iter().zip(results.into_iter().flatten()) {
-        counts += c;
-        for row in 0..tile.height {
-            let start = ((tile.y + row) * w + tile.x) as usize;
-            let src = (row * tile.width) as usize;
-            pixels[start..start + tile.width as usize]
-                .copy_from_slice(&values[src..src + tile.width as usize]);
-        }
-    }
-    let frame = Frame {
-        width: w,
-        height: h,
-        view: settings.view,
-        pixels,
-    };
+    let (frame, counts) =
+        crate::render::assemble_tiles(w, h, settings.view, &all, results.into_iter().flatten());
     let one_sample_error = {
         let mut one = shared.one_sample.lock().unwrap_or_else(|e| e.into_inner());
         match kind {

@@ -80,3 +80,25 @@ pub fn diff(a: &[u8], b: &[u8], tolerance: u8) -> (usize, u8) {
     }
     (count, largest)
 }
+
+/// Runs `glint render --from-png first -o again` and compares the two
+/// PNGs: returns the number of differing pixels and the largest difference.
+pub fn rerender_from_png(first: &Path, again: &Path) -> (usize, u8) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_glint"))
+        .args(["render", "--from-png"])
+        .arg(first)
+        .arg("-o")
+        .arg(again)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}: {}",
+        first.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let a = image::open(first).unwrap().to_rgb8();
+    let b = image::open(again).unwrap().to_rgb8();
+    assert_eq!(a.dimensions(), b.dimensions(), "{}", first.display());
+    diff(a.as_raw(), b.as_raw(), 0)
+}

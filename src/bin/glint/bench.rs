@@ -125,13 +125,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let mut results = Vec::new();
     for path in &args.scenes {
         let (mut scene, load_s) = load_scene(path)?;
-        args.octree_params.apply(&mut scene.octree_params);
-        let mut settings = RenderSettings::from_scene(&scene);
-        if let Some((w, h)) = args.size {
-            (settings.width, settings.height) = (w, h);
-        }
-        settings.samples = args.samples.unwrap_or(settings.samples);
-        settings.max_depth = args.max_depth.unwrap_or(settings.max_depth);
+        let settings = bench_settings(args, &mut scene);
         eprintln!(
             "bench {} ({} shapes, {}x{}, {} spp, {} repeats)",
             path.display(),
@@ -323,13 +317,7 @@ fn sweep(args: &BenchArgs) -> Result<()> {
     }
     for path in &args.scenes {
         let (mut scene, _) = load_scene(path)?;
-        args.octree_params.apply(&mut scene.octree_params);
-        let mut settings = RenderSettings::from_scene(&scene);
-        if let Some((w, h)) = args.size {
-            (settings.width, settings.height) = (w, h);
-        }
-        settings.samples = args.samples.unwrap_or(settings.samples);
-        settings.max_depth = args.max_depth.unwrap_or(settings.max_depth);
+        let mut settings = bench_settings(args, &mut scene);
         settings.use_octree = true;
         eprintln!("sweep {}", path.display());
         for &cost_driven in &[true, false] {
@@ -405,4 +393,17 @@ fn print_sweep_row(r: &SweepRow) {
         r.octree_stats.nodes,
         r.octree_stats.memory_bytes as f64 / 1024.0
     );
+}
+
+/// The scene's settings with the command line's overrides applied (and its
+/// octree parameters to the scene).
+fn bench_settings(args: &BenchArgs, scene: &mut glint::scene::Scene) -> RenderSettings {
+    args.octree_params.apply(&mut scene.octree_params);
+    let mut settings = RenderSettings::from_scene(scene);
+    if let Some((w, h)) = args.size {
+        (settings.width, settings.height) = (w, h);
+    }
+    settings.samples = args.samples.unwrap_or(settings.samples);
+    settings.max_depth = args.max_depth.unwrap_or(settings.max_depth);
+    settings
 }
