@@ -1,7 +1,13 @@
-//! Reproducible PNG exports: every PNG glint writes carries, in text
-//! chunks, the glint version, the scene file's SHA-256 and full text, and
-//! every setting that shaped the image, so `glint render --from-png`
-//! can render it again and `glint info` can say how it was made.
+//! Reproducible PNG exports: every PNG glint writes carries the glint
+//! version, the scene file's SHA-256 and full text, and every setting that
+//! shaped the image, so `glint render --from-png` can render it again and
+//! `glint info` can say how it was made.
+//!
+//! The small parts are standard iTXt text chunks, which any PNG tool shows.
+//! The scene text can be megabytes (gears.nff is 1.3 MB), and common readers
+//! refuse text chunks that decompress past 1 MB (Pillow's
+//! `MAX_TEXT_CHUNK`), so it goes in a private ancillary chunk, `glSc`, that
+//! readers skip: zlib-compressed UTF-8, written before the image data.
 
 use std::path::{Path, PathBuf};
 
@@ -19,6 +25,13 @@ pub const KEY_SCENE_PATH: &str = "glint:scene-path";
 pub const KEY_SCENE_SHA256: &str = "glint:scene-sha256";
 pub const KEY_SCENE: &str = "glint:scene";
 pub const KEY_SETTINGS: &str = "glint:settings";
+/// The private chunk holding the scene text (ancillary, private,
+/// safe to copy: lower, lower, upper, lower).
+pub const SCENE_CHUNK: [u8; 4] = *b"glSc";
+/// Largest scene text a record may hold once decompressed: far above any
+/// scene file (the largest SPD size, tetra_s8, is 5 MB), and a bound on
+/// what a crafted PNG can make glint allocate.
+pub const MAX_SCENE_TEXT: usize = 256 << 20;
 
 /// How an image was made: enough to make it again.
 #[derive(Clone, Debug, PartialEq)]
@@ -223,17 +236,25 @@ fn write_png(
             path: path.to_owned(),
             message: e.to_string(),
         })?;
-        for (key, text, compressed) in [
-            (KEY_VERSION, r.glint_version.as_str(), false),
-            (KEY_SCENE_PATH, r.scene_path.as_str(), false),
-            (KEY_SCENE_SHA256, r.scene_sha256.as_str(), false),
-            (KEY_SETTINGS, settings.as_str(), false),
-            (KEY_SCENE, r.scene_text.as_str(), true),
+        for (key, text) in [
+            (KEY_VERSION, r.glint_version.as_str()),
+            (KEY_SCENE_PATH, r.scene_path.as_str()),
+            (KEY_SCENE_SHA256, r.scene_sha256.as_str()),
+            (KEY_SETTINGS, settings.as_str()),
         ] {
             let mut chunk = png::text_metadata::ITXtChunk::new(key, text);
-            chunk.compressed = compressed;
+            // Settings with many edited materials can grow; compressed they
+            // stay far below what readers accept.
+            chunk.compressed = text.len() > 1024;
             writer.write_text_chunk(&chunk).map_err(encode)?;
         }
+        let scene = compress(r.scene_text.as_bytes()).map_err(|e| ExportError::Encode {
+            path: path.to_owned(),
+            message: e.to_string(),
+        })?;
+        writer
+            .write_chunk(png::chunk::ChunkType(SCENE_CHUNK), &scene)
+            .map_err(encode)?;
     }
     writer.write_image_data(rgb).map_err(encode)?;
     writer.finish().map_err(encode)
@@ -278,11 +299,21 @@ pub fn read_record(path: &Path) -> Result<RenderRecord, ExportError> {
             key: KEY_SETTINGS,
             message: e.to_string(),
         })?;
+    // Records written before the private chunk existed keep the scene in
+    // an iTXt chunk.
+    let scene_text = match private_chunk(path, SCENE_CHUNK)? {
+        Some(data) => decompress(&data).map_err(|message| ExportError::Malformed {
+            path: path.to_owned(),
+            key: KEY_SCENE,
+            message,
+        })?,
+        None => text(KEY_SCENE)?,
+    };
     let record = RenderRecord {
         glint_version: text(KEY_VERSION)?,
         scene_path: text(KEY_SCENE_PATH)?,
         scene_sha256: text(KEY_SCENE_SHA256)?,
-        scene_text: text(KEY_SCENE)?,
+        scene_text,
         settings,
     };
     validate(&record.settings).map_err(|message| ExportError::Malformed {
@@ -299,6 +330,91 @@ pub fn read_record(path: &Path) -> Result<RenderRecord, ExportError> {
         });
     }
     Ok(record)
+}
+
+fn compress(data: &[u8]) -> std::io::Result<Vec<u8>> {
+    use std::io::Write;
+    let mut encoder = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
+    encoder.write_all(data)?;
+    encoder.finish()
+}
+
+/// Inflates a zlib stream into UTF-8 text of at most [`MAX_SCENE_TEXT`] bytes.
+fn decompress(data: &[u8]) -> Result<String, String> {
+    use std::io::Read;
+    let mut out = Vec::new();
+    flate2::read::ZlibDecoder::new(data)
+        .take(MAX_SCENE_TEXT as u64 + 1)
+        .read_to_end(&mut out)
+        .map_err(|e| format!("cannot decompress: {e}"))?;
+    if out.len() > MAX_SCENE_TEXT {
+        return Err(format!("scene text exceeds {MAX_SCENE_TEXT} bytes"));
+    }
+    String::from_utf8(out).map_err(|e| format!("not UTF-8 text: {e}"))
+}
+
+/// The data of the first chunk of type `kind` before the image data, if
+/// any. The png crate skips chunks it does not know, so glint walks the
+/// chunk list itself (PNG spec, section 5.3: length, type, data, CRC).
+fn private_chunk(path: &Path, kind: [u8; 4]) -> Result<Option<Vec<u8>>, ExportError> {
+    use std::io::Read;
+    let decode = |message: &str| ExportError::Decode {
+        path: path.to_owned(),
+        message: message.to_owned(),
+    };
+    let mut file =
+        std::io::BufReader::new(
+            std::fs::File::open(path).map_err(|source| ExportError::Read {
+                path: path.to_owned(),
+                source,
+            })?,
+        );
+    let read_error = |source| ExportError::Read {
+        path: path.to_owned(),
+        source,
+    };
+    let mut signature = [0u8; 8];
+    file.read_exact(&mut signature).map_err(read_error)?;
+    if signature != *b"\x89PNG\r\n\x1a\n" {
+        return Err(decode("not a PNG file"));
+    }
+    loop {
+        let mut header = [0u8; 8];
+        if file.read_exact(&mut header).is_err() {
+            return Ok(None);
+        }
+        let length = u32::from_be_bytes([header[0], header[1], header[2], header[3]]);
+        let chunk_type = [header[4], header[5], header[6], header[7]];
+        if &chunk_type == b"IDAT" || &chunk_type == b"IEND" {
+            return Ok(None);
+        }
+        if chunk_type != kind {
+            // Skip the data and the CRC.
+            std::io::copy(
+                &mut (&mut file).take(length as u64 + 4),
+                &mut std::io::sink(),
+            )
+            .map_err(read_error)?;
+            continue;
+        }
+        let mut data = Vec::new();
+        (&mut file)
+            .take(length as u64)
+            .read_to_end(&mut data)
+            .map_err(read_error)?;
+        let mut crc = [0u8; 4];
+        file.read_exact(&mut crc).map_err(read_error)?;
+        if data.len() != length as usize {
+            return Err(decode("the file ends inside a chunk"));
+        }
+        let mut hasher = crc32fast::Hasher::new();
+        hasher.update(&chunk_type);
+        hasher.update(&data);
+        if hasher.finalize() != u32::from_be_bytes(crc) {
+            return Err(decode("the scene chunk is corrupt (CRC mismatch)"));
+        }
+        return Ok(Some(data));
+    }
 }
 
 /// The limits scene files and the command line enforce, applied to a
@@ -318,6 +434,15 @@ fn validate(s: &RecordedSettings) -> Result<(), String> {
     if s.octree_params.leaf_size == 0 {
         return Err("octree leaf_size must be at least 1".into());
     }
+    if !(1..=8).contains(&s.octree_params.max_duplication) {
+        return Err("octree max_duplication must lie in 1..=8".into());
+    }
+    if !(1..=crate::accel::MAX_MEMORY_BUDGET_MIB).contains(&s.octree_params.memory_budget_mib) {
+        return Err(format!(
+            "octree memory budget must lie in 1..={} MiB",
+            crate::accel::MAX_MEMORY_BUDGET_MIB
+        ));
+    }
     if r.width == 0 || r.height == 0 || r.width as u64 * r.height as u64 > 1 << 28 {
         return Err(format!(
             "image size {}x{} is not allowed",
@@ -330,25 +455,13 @@ fn validate(s: &RecordedSettings) -> Result<(), String> {
         return Err("overlay depth is above the octree's limit".into());
     }
     if let Some(e) = &s.edits {
-        let finite = |v: DVec3| v.is_finite();
+        // The ranges scene files are held to (scenes/README.md).
         for (i, l) in e.lights.iter().enumerate() {
-            if !finite(l.position) || !finite(l.color) {
-                return Err(format!("light {i} has a non-finite value"));
-            }
+            l.validate().map_err(|m| format!("light {i}: {m}"))?;
         }
         for m in &e.materials {
-            let values = [
-                m.ka,
-                m.kd,
-                m.ks,
-                m.shininess,
-                m.reflectivity,
-                m.transparency,
-                m.ior,
-            ];
-            if !finite(m.color) || values.iter().any(|v| !v.is_finite()) || m.ior <= 0.0 {
-                return Err(format!("material `{}` has an invalid value", m.name));
-            }
+            m.validate()
+                .map_err(|e| format!("material `{}`: {e}", m.name))?;
         }
     }
     Ok(())

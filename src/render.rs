@@ -4,7 +4,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use rayon::prelude::*;
 
-use crate::accel::{ClosestHit, Occlusion, Octree, closest_brute_force, occlusion_brute_force};
+use crate::accel::{ClosestHit, Octree, closest_brute_force, occlusion_brute_force};
 use crate::camera::{Camera, CameraError, CameraSpec, sample_offsets};
 use crate::math::{Color, DVec3, Ray, offset_ray_origin, reflect, refract};
 use crate::ray_tree::{HitRecord, NoRecord, RayKind, RayNode, RayRecorder, ShadowRecord};
@@ -180,6 +180,11 @@ impl std::ops::AddAssign for TileCounts {
     }
 }
 
+/// Crossings of one material closer than this, relative to the scene's
+/// magnitude, are one surface: far above the rounding of hit distances,
+/// far below any thickness a scene models.
+const SAME_SURFACE_RELATIVE: f64 = 1e-9;
+
 /// A scene prepared for rendering with fixed settings.
 pub struct Renderer<'a> {
     scene: &'a Scene,
@@ -188,7 +193,7 @@ pub struct Renderer<'a> {
     camera: Camera,
     offsets: Vec<(f64, f64)>,
     is_transparent: Vec<bool>,
-    /// Magnitude of the scene's coordinates: the floor of ray offsets.
+    /// Magnitude of the scene's surfaces and the eye: the floor of ray offsets.
     floor_scale: f64,
 }
 
@@ -235,7 +240,7 @@ impl<'a> Renderer<'a> {
             offsets: sample_offsets(settings.samples),
             is_transparent,
             floor_scale: scene
-                .extent_bounds()
+                .geometry_bounds()
                 .grow(camera.eye)
                 .max_abs()
                 .max(f64::MIN_POSITIVE),
@@ -259,9 +264,15 @@ impl<'a> Renderer<'a> {
         }
     }
 
-    /// Fraction of light passing from `origin` to a light `distance` away.
+    /// Fraction of light passing along the shadow ray to a light `distance`
+    /// away. Every surface crossed multiplies it by its material's
+    /// transparency (entering and leaving a glass sphere or a closed glass
+    /// mesh: T twice), whatever kind of shape it is; crossings of the same
+    /// material at the same place count once (coincident triangles, a ray
+    /// through a mesh's shared edge, two glass bodies touching: no
+    /// interface), and any opaque surface blocks the light.
     fn transmittance<C: Counter>(&self, ray: &PreparedRay, distance: f64, counter: &mut C) -> f64 {
-        let occlusion = if self.settings.use_octree {
+        let found = if self.settings.use_octree {
             self.octree.occlusion(
                 &self.scene.shapes,
                 &self.is_transparent,
@@ -278,20 +289,23 @@ impl<'a> Renderer<'a> {
                 counter,
             )
         };
-        match occlusion {
-            Occlusion::Clear => 1.0,
-            Occlusion::Blocked => 0.0,
-            Occlusion::Transparent(mut shapes) => {
-                // A canonical order makes the product independent of the
-                // order the shapes were found in.
-                shapes.sort_unstable();
-                shapes.dedup();
-                shapes.iter().fold(1.0, |acc, &i| {
-                    let m = self.scene.shape_materials[i as usize] as usize;
-                    acc * self.scene.materials[m].transparency
-                })
-            }
+        if found.is_blocked() {
+            return 0.0;
         }
+        // Crossings come sorted by distance, so the product is the same
+        // whichever order they were found in.
+        let same_place = SAME_SURFACE_RELATIVE * self.floor_scale;
+        let mut pass = 1.0;
+        let mut previous: Option<(f64, u32)> = None;
+        for &(t, shape) in found.transparent() {
+            let material = self.scene.shape_materials[shape as usize];
+            let repeat = previous.is_some_and(|(pt, pm)| pm == material && t - pt <= same_place);
+            if !repeat {
+                pass *= self.scene.materials[material as usize].transparency;
+            }
+            previous = Some((t, material));
+        }
+        pass
     }
 
     /// Colour seen along `ray`, which is at recursion `depth` (eye ray = 1).

@@ -4,7 +4,7 @@
 mod common;
 
 use common::{all_scenes, load, render_with};
-use glint::accel::{Occlusion, Octree, OctreeParams, closest_brute_force, occlusion_brute_force};
+use glint::accel::{Octree, OctreeParams, closest_brute_force, occlusion_brute_force};
 use glint::math::{DVec3, Ray};
 use glint::shapes::{PreparedRay, Shape, Sphere, Triangle};
 use glint::stats::NoCounts;
@@ -14,7 +14,7 @@ use proptest::prelude::*;
 fn octree_on_and_off_give_identical_bytes_for_every_scene() {
     for name in all_scenes() {
         let scene = load(&name);
-        let octree = Octree::build(&scene.shapes, scene.octree_params);
+        let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
         // Brute force over tens of thousands of shapes is slow: keep the
         // biggest scenes small.
         let side = if scene.shapes.len() > 20_000 { 12 } else { 40 };
@@ -80,20 +80,16 @@ proptest! {
         transparent_mask in any::<u64>(),
         shadow_length in 0.5..20.0f64,
     ) {
-        let params = OctreeParams { max_depth, leaf_size, cost_driven: max_depth % 2 == 0 };
-        let octree = Octree::build(&shapes, params);
+        let params = OctreeParams { max_depth, leaf_size, cost_driven: max_depth % 2 == 0, ..Default::default() };
+        let octree = Octree::build(&shapes, params).unwrap();
         let is_transparent: Vec<bool> = (0..shapes.len()).map(|i| transparent_mask >> (i % 64) & 1 == 1).collect();
         for ray in rays {
             let prepared = PreparedRay::new(ray);
             let brute = closest_brute_force(&shapes, &prepared, f64::INFINITY, &mut NoCounts);
             let tree = octree.closest(&shapes, &prepared, f64::INFINITY, &mut NoCounts);
             prop_assert_eq!(brute, tree, "closest hit differs for {:?}", ray);
-            let canonical = |o: Occlusion| match o {
-                Occlusion::Transparent(mut v) => { v.sort_unstable(); v.dedup(); Occlusion::Transparent(v) }
-                other => other,
-            };
-            let b = canonical(occlusion_brute_force(&shapes, &is_transparent, &prepared, shadow_length, &mut NoCounts));
-            let t = canonical(octree.occlusion(&shapes, &is_transparent, &prepared, shadow_length, &mut NoCounts));
+            let b = occlusion_brute_force(&shapes, &is_transparent, &prepared, shadow_length, &mut NoCounts);
+            let t = octree.occlusion(&shapes, &is_transparent, &prepared, shadow_length, &mut NoCounts);
             prop_assert_eq!(b, t, "shadow verdict differs for {:?}", ray);
         }
     }
@@ -122,9 +118,10 @@ fn rays_in_split_planes_and_through_corners() {
         OctreeParams {
             max_depth: 6,
             leaf_size: 1,
-            cost_driven: false,
+            ..Default::default()
         },
-    );
+    )
+    .unwrap();
     let mut checked = 0;
     for sx in [-1.0, 1.0] {
         for sy in [-1.0, 1.0] {

@@ -17,7 +17,7 @@ fn every_scene_renders_finite_and_non_blank() {
     assert!(scenes.len() >= 9, "scenes found: {scenes:?}");
     for name in scenes {
         let scene = load(&name);
-        let octree = Octree::build(&scene.shapes, scene.octree_params);
+        let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
         let (image, counts) = render_with(&scene, &octree, 48, 36, |s| s.samples = 1);
         assert_eq!(
             counts.nonfinite_samples, 0,
@@ -41,7 +41,7 @@ fn output_is_identical_for_any_thread_count() {
         "scenes/spd/teapot.nff",
     ] {
         let scene = load(name);
-        let octree = Octree::build(&scene.shapes, scene.octree_params);
+        let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
         let render = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
@@ -69,15 +69,15 @@ fn head_on_plane_matches_the_analytic_colour() {
         shininess: 10.0,
         ..Material::default()
     };
-    let mut scene = Scene {
-        name: "analytic".into(),
-        camera: CameraSpec {
+    let mut scene = Scene::empty(
+        "analytic".into(),
+        CameraSpec {
             eye: DVec3::new(0.0, 0.0, 10.0),
             lookat: DVec3::ZERO,
             up: DVec3::Y,
             fov: 30.0,
         },
-        image: ImageSettings {
+        ImageSettings {
             width: 3,
             height: 3,
             samples: 1,
@@ -85,21 +85,14 @@ fn head_on_plane_matches_the_analytic_colour() {
             background: DVec3::ZERO,
             ambient: DVec3::splat(0.2),
         },
-        octree_enabled: true,
-        octree_params: Default::default(),
-        materials: vec![material.clone()],
-        lights: vec![Light {
-            position: DVec3::new(0.0, 0.0, 10.0),
-            color: DVec3::splat(0.5),
-        }],
-        shapes: vec![],
-        shape_materials: vec![],
-        vertex_normals: vec![],
-        dropped_triangles: 0,
-        source_text: String::new(),
-    };
+    );
+    scene.materials = vec![material.clone()];
+    scene.lights = vec![Light {
+        position: DVec3::new(0.0, 0.0, 10.0),
+        color: DVec3::splat(0.5),
+    }];
     scene.push(Shape::Plane(Plane::new(DVec3::ZERO, DVec3::Z)), 0);
-    let octree = Octree::build(&scene.shapes, scene.octree_params);
+    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
     let renderer = Renderer::new(&scene, &octree, RenderSettings::from_scene(&scene)).unwrap();
     let (frame, _) = renderer.render(false, None);
     let centre = frame.pixels[4];
@@ -121,7 +114,7 @@ fn head_on_plane_matches_the_analytic_colour() {
 #[test]
 fn quadric_sphere_renders_like_the_analytic_sphere() {
     let mut scene = load("scenes/sphere.toml");
-    let octree = Octree::build(&scene.shapes, scene.octree_params);
+    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
     let (analytic, _) = render_with(&scene, &octree, 160, 120, |s| s.samples = 16);
     let Shape::Sphere(Sphere {
         center: c,
@@ -145,7 +138,7 @@ fn quadric_sphere_renders_like_the_analytic_sphere() {
         ],
         None,
     )));
-    let octree = Octree::build(&scene.shapes, scene.octree_params);
+    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
     let (quadric, _) = render_with(&scene, &octree, 160, 120, |s| s.samples = 16);
     let (over_one, largest) = diff(&analytic, &quadric, 0);
     let (over_two, _) = diff(&analytic, &quadric, 2);
@@ -162,7 +155,7 @@ fn quadric_sphere_renders_like_the_analytic_sphere() {
 fn sixteen_samples_differ_from_one_only_near_edges() {
     for name in ["scenes/sphere.toml", "scenes/quadrics.toml"] {
         let scene = load(name);
-        let octree = Octree::build(&scene.shapes, scene.octree_params);
+        let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
         let (w, h) = (120u32, 90u32);
         let (one, _) = render_with(&scene, &octree, w, h, |s| s.samples = 1);
         let (sixteen, _) = render_with(&scene, &octree, w, h, |s| s.samples = 16);
@@ -204,7 +197,7 @@ fn sixteen_samples_differ_from_one_only_near_edges() {
 #[test]
 fn normals_and_depth_views_are_as_documented() {
     let scene = load("scenes/sphere.toml");
-    let octree = Octree::build(&scene.shapes, scene.octree_params);
+    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
     let (w, h) = (81u32, 61u32);
     let (normals, _) = render_with(&scene, &octree, w, h, |s| {
         s.samples = 1;

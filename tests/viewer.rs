@@ -113,7 +113,7 @@ fn job(
     anti_aliasing: bool,
 ) -> (Job, Arc<glint::scene::Scene>, Arc<Octree>) {
     let scene = Arc::new(common::load(scene));
-    let octree = Arc::new(Octree::build(&scene.shapes, scene.octree_params));
+    let octree = Arc::new(Octree::build(&scene.shapes, scene.octree_params).unwrap());
     let mut settings = RenderSettings::from_scene(&scene);
     settings.width = width;
     settings.height = height;

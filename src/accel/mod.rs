@@ -4,7 +4,10 @@
 
 mod octree;
 
-pub use octree::{MAX_OCTREE_DEPTH, Octree, OctreeCell, OctreeParams, OctreeStats};
+pub use octree::{
+    DEFAULT_MEMORY_BUDGET_MIB, MAX_MEMORY_BUDGET_MIB, MAX_OCTREE_DEPTH, Octree, OctreeCell,
+    OctreeError, OctreeParams, OctreeStats,
+};
 
 use crate::shapes::{PreparedRay, Shape, ShapeHit};
 use crate::stats::Counter;
@@ -71,48 +74,148 @@ pub fn closest_brute_force<C: Counter>(
     best
 }
 
-/// What a shadow ray found between its origin and the light.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub enum Occlusion {
-    #[default]
-    Clear,
-    /// Only transparent shapes are in the way: their indices, unordered,
-    /// possibly repeated.
-    Transparent(Vec<u32>),
-    Blocked,
+/// How many transparent crossings a shadow ray keeps: the nearest ones.
+/// Light through more surfaces than this is attenuated by these alone
+/// (even at a transparency of 0.9, 32 surfaces pass 3% of it).
+pub const MAX_SHADOW_CROSSINGS: usize = 32;
+
+/// What a shadow ray met between its origin and the light: whether an
+/// opaque surface blocks it, and otherwise every crossing of a transparent
+/// surface, as (distance, shape) sorted by distance then shape index. The
+/// order and the set do not depend on the order shapes were tested in, so
+/// the octree and brute force answer alike. Fixed size: no allocation per ray.
+#[derive(Clone)]
+pub struct ShadowCrossings {
+    blocked: bool,
+    len: usize,
+    hits: [(f64, u32); MAX_SHADOW_CROSSINGS],
 }
 
-impl Occlusion {
-    /// Records a hit on `index`; `true` if the ray is now fully blocked.
-    #[inline(always)]
-    pub(crate) fn record(&mut self, index: u32, transparent: bool) -> bool {
-        if !transparent {
-            *self = Occlusion::Blocked;
-            return true;
+impl Default for ShadowCrossings {
+    fn default() -> Self {
+        Self {
+            blocked: false,
+            len: 0,
+            hits: [(0.0, 0); MAX_SHADOW_CROSSINGS],
         }
-        match self {
-            Occlusion::Clear => *self = Occlusion::Transparent(vec![index]),
-            Occlusion::Transparent(v) => v.push(index),
-            Occlusion::Blocked => return true,
-        }
-        false
     }
 }
 
-/// Any hits in `(0, t_max)`, testing every shape; stops at the first opaque one.
+/// Equal when both are blocked (what was crossed before the blocker does
+/// not matter), or both hold the same transparent crossings.
+impl PartialEq for ShadowCrossings {
+    fn eq(&self, other: &Self) -> bool {
+        self.blocked == other.blocked && self.transparent() == other.transparent()
+    }
+}
+
+impl std::fmt::Debug for ShadowCrossings {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.blocked {
+            f.write_str("Blocked")
+        } else {
+            f.debug_list().entries(self.transparent()).finish()
+        }
+    }
+}
+
+impl ShadowCrossings {
+    pub fn is_blocked(&self) -> bool {
+        self.blocked
+    }
+
+    /// Transparent crossings, nearest first (empty when blocked).
+    pub fn transparent(&self) -> &[(f64, u32)] {
+        if self.blocked {
+            &[]
+        } else {
+            &self.hits[..self.len]
+        }
+    }
+
+    /// Records a crossing of a transparent surface. The same crossing found
+    /// twice (a shape referenced from two leaves) is kept once; when full,
+    /// the farthest crossing gives way.
+    #[inline]
+    fn add(&mut self, t: f64, shape: u32) {
+        let key = (t, shape);
+        let before = |a: &(f64, u32)| a.0 < t || (a.0 == t && a.1 < shape);
+        let at = self.hits[..self.len].partition_point(before);
+        if at < self.len && self.hits[at] == key {
+            return;
+        }
+        if at == MAX_SHADOW_CROSSINGS {
+            return;
+        }
+        let end = self.len.min(MAX_SHADOW_CROSSINGS - 1);
+        self.hits.copy_within(at..end, at + 1);
+        self.hits[at] = key;
+        self.len = end + 1;
+    }
+}
+
+/// Tests shape `index` against a shadow ray over `(0, t_max)`, recording
+/// what it crosses; `true` once an opaque surface blocks the ray.
+#[inline(always)]
+pub(crate) fn test_occlusion<C: Counter>(
+    shapes: &[Shape],
+    is_transparent: &[bool],
+    index: u32,
+    ray: &PreparedRay,
+    t_max: f64,
+    found: &mut ShadowCrossings,
+    counter: &mut C,
+) -> bool {
+    counter.intersection_test();
+    let shape = &shapes[index as usize];
+    if !is_transparent[index as usize] {
+        if shape.intersect(ray, t_max).is_some() {
+            found.blocked = true;
+        }
+        return found.blocked;
+    }
+    for &t in shape.crossings(ray, t_max).as_slice() {
+        found.add(t, index);
+    }
+    false
+}
+
+/// Everything in `(0, t_max)`, testing every shape; stops at the first opaque one.
 pub fn occlusion_brute_force<C: Counter>(
     shapes: &[Shape],
     is_transparent: &[bool],
     ray: &PreparedRay,
     t_max: f64,
     counter: &mut C,
-) -> Occlusion {
-    let mut occlusion = Occlusion::Clear;
-    for (i, shape) in shapes.iter().enumerate() {
-        counter.intersection_test();
-        if shape.intersect(ray, t_max).is_some() && occlusion.record(i as u32, is_transparent[i]) {
+) -> ShadowCrossings {
+    let mut found = ShadowCrossings::default();
+    for i in 0..shapes.len() as u32 {
+        if test_occlusion(shapes, is_transparent, i, ray, t_max, &mut found, counter) {
             break;
         }
     }
-    occlusion
+    found
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn crossings_are_sorted_deduplicated_and_keep_the_nearest() {
+        let mut c = ShadowCrossings::default();
+        for (t, s) in [(3.0, 1), (1.0, 4), (3.0, 0), (1.0, 4), (2.0, 9)] {
+            c.add(t, s);
+        }
+        assert_eq!(c.transparent(), &[(1.0, 4), (2.0, 9), (3.0, 0), (3.0, 1)]);
+        let mut full = ShadowCrossings::default();
+        for k in (0..2 * MAX_SHADOW_CROSSINGS).rev() {
+            full.add(k as f64, 0);
+        }
+        let kept: Vec<f64> = full.transparent().iter().map(|h| h.0).collect();
+        let nearest: Vec<f64> = (0..MAX_SHADOW_CROSSINGS).map(|k| k as f64).collect();
+        assert_eq!(kept, nearest);
+        full.blocked = true;
+        assert!(full.transparent().is_empty());
+    }
 }

@@ -1,10 +1,20 @@
 //! Octree over the bounded shapes of a scene.
 //!
-//! Build: each node is split at its centre into eight octants until it holds
-//! at most `leaf_size` references or reaches `max_depth`; a shape is
-//! referenced from every leaf it really overlaps (exact triangle/box and
-//! sphere/box tests). Optionally a surface-area cost estimate (MacDonald &
-//! Booth 1990) keeps a node as a leaf when splitting would not pay.
+//! Build: breadth first, level by level, each node is split at its centre
+//! into eight octants; a shape is referenced from every cell its surface
+//! really touches (exact triangle/box and sphere/box tests). A node stays a
+//! leaf when it holds at most `leaf_size` references, reaches `max_depth`,
+//! or when a split would not separate its references: every non-empty
+//! child would hold all of them, or the children together would hold more
+//! than `max_duplication` times as many (the termination criterion Havran
+//! discusses for hierarchical subdivisions: splitting large overlapping
+//! objects only multiplies references). Optionally a surface-area cost
+//! estimate (MacDonald & Booth 1990) keeps a node as a leaf when splitting
+//! would not pay. A memory budget bounds the whole structure: once a split
+//! would exceed it, nodes stay leaves, which is always correct, only slower.
+//! Because the build goes level by level and decides in a fixed order, the
+//! budget is spent on the coarse levels first and the tree is the same for
+//! any number of threads.
 //!
 //! Traversal: front to back in the parametric manner of Revelles, Ureña &
 //! Lastra, "An Efficient Parametric Algorithm for Octree Traversal" (WSCG
@@ -15,7 +25,7 @@
 
 use rayon::prelude::*;
 
-use super::{ClosestHit, Occlusion, test_closest};
+use super::{ClosestHit, ShadowCrossings, test_closest, test_occlusion};
 use crate::math::{Aabb, DVec3};
 use crate::shapes::{PreparedRay, Shape};
 use crate::stats::Counter;
@@ -33,6 +43,32 @@ pub struct OctreeParams {
     /// Stop splitting where the surface-area cost estimate says a split
     /// would cost more than it saves.
     pub cost_driven: bool,
+    /// A node stays a leaf when its children would hold more than this many
+    /// times its references (8 never stops: eight children hold at most 8x).
+    #[serde(default = "default_max_duplication")]
+    pub max_duplication: u32,
+    /// Budget for the built structure (nodes and references), in MiB: past
+    /// it, nodes stay leaves.
+    #[serde(default = "default_memory_budget_mib")]
+    pub memory_budget_mib: u32,
+}
+
+/// Chosen by `glint bench --sweep` (benches/octree_sweep_256.md).
+pub const DEFAULT_MAX_DUPLICATION: u32 = 8;
+/// Far above what any real scene needs (the 65,536-triangle tetra_s8 takes
+/// 15 MiB), far below this machine's memory, and small enough that the
+/// build finishes in seconds even when a scene would use it all.
+pub const DEFAULT_MEMORY_BUDGET_MIB: u32 = 128;
+
+/// Largest budget glint accepts: references are 32-bit indices.
+pub const MAX_MEMORY_BUDGET_MIB: u32 = 8192;
+
+fn default_max_duplication() -> u32 {
+    DEFAULT_MAX_DUPLICATION
+}
+
+fn default_memory_budget_mib() -> u32 {
+    DEFAULT_MEMORY_BUDGET_MIB
 }
 
 impl Default for OctreeParams {
@@ -44,8 +80,27 @@ impl Default for OctreeParams {
             max_depth: 10,
             leaf_size: 8,
             cost_driven: false,
+            max_duplication: DEFAULT_MAX_DUPLICATION,
+            memory_budget_mib: DEFAULT_MEMORY_BUDGET_MIB,
         }
     }
+}
+
+impl OctreeParams {
+    fn memory_budget_bytes(&self) -> u64 {
+        self.memory_budget_mib as u64 * 1024 * 1024
+    }
+}
+
+#[derive(Debug, thiserror::Error, PartialEq, Eq)]
+pub enum OctreeError {
+    /// The allocator refused memory the build needed (for example under a
+    /// memory limit below the budget).
+    #[error(
+        "not enough memory to build the octree ({bytes} more bytes were refused); \
+         lower the octree memory budget or switch the octree off"
+    )]
+    OutOfMemory { bytes: u64 },
 }
 
 /// Machine-independent description of a built octree, with Havran's names:
@@ -59,6 +114,14 @@ pub struct OctreeStats {
     pub references: u64,
     pub max_depth: u32,
     pub memory_bytes: u64,
+    /// The budget the build had (`memory_budget_mib` in bytes).
+    pub memory_budget_bytes: u64,
+    /// Nodes left as leaves because splitting them would have exceeded
+    /// the budget (0 when the budget never bound).
+    pub leaves_stopped_by_budget: u64,
+    /// Nodes left as leaves because a split would not have separated their
+    /// references (`max_duplication`, or every child holding all of them).
+    pub leaves_stopped_by_duplication: u64,
 }
 
 /// A cell of the octree as the overlay draws it.
@@ -94,19 +157,17 @@ pub struct Octree {
     stats: OctreeStats,
 }
 
-enum BuildNode {
-    Leaf(Vec<u32>),
-    Interior(Box<[BuildNode; 8]>),
-}
-
 /// Relative growth of boxes used to classify shapes, so that a shape
 /// touching a cell in exact arithmetic is never missed through rounding.
 const CLASSIFY_PAD: f64 = 1e-9;
 /// Cost of one traversal step relative to one intersection test, for the
 /// surface-area estimate.
 const TRAVERSAL_COST: f64 = 1.0;
-/// Below this many references a node's children are built on one thread.
+/// Below this many references a node is classified on one thread.
 const PARALLEL_MIN: usize = 2048;
+/// Nodes of a level are classified in batches of about this many
+/// references, so a level's candidate children never all exist at once.
+const BATCH_REFERENCES: usize = 1 << 20;
 
 /// The box of octant `child` of `[min, max]`, split at its centre. Build and
 /// traversal both use this, so their cells are bit-identical.
@@ -131,7 +192,10 @@ fn centre(min: DVec3, max: DVec3) -> DVec3 {
 }
 
 impl Octree {
-    pub fn build(shapes: &[Shape], params: OctreeParams) -> Self {
+    /// Builds the octree over the bounded shapes (unbounded ones are kept
+    /// aside and tested for every ray). Fails only if the allocator refuses
+    /// memory; the budget in `params` normally keeps the build far from that.
+    pub fn build(shapes: &[Shape], params: OctreeParams) -> Result<Self, OctreeError> {
         let mut bounds = Aabb::EMPTY;
         let mut bounded = Vec::new();
         let mut unbounded = Vec::new();
@@ -150,10 +214,13 @@ impl Octree {
             refs: Vec::new(),
             unbounded,
             params,
-            stats: OctreeStats::default(),
+            stats: OctreeStats {
+                memory_budget_bytes: params.memory_budget_bytes(),
+                ..OctreeStats::default()
+            },
         };
         if bounded.is_empty() {
-            return tree;
+            return Ok(tree);
         }
         // A cube around the shapes: cells stay cubes at every level, so a
         // ray crosses as few of them as possible (flat cells of a flat scene
@@ -161,17 +228,29 @@ impl Octree {
         let half = DVec3::splat(0.5 * bounds.extent().max_element());
         let c = bounds.center();
         tree.bounds = Aabb::new(c - half, c + half).padded(CLASSIFY_PAD);
-        let root = build_node(
+        let mut builder = Builder {
             shapes,
-            bounded,
-            tree.bounds.min,
-            tree.bounds.max,
-            0,
-            &params,
-        );
-        tree.nodes.push(Node { first: 0, count: 0 });
-        let mut max_depth = 0;
-        flatten(root, 0, 0, &mut tree.nodes, &mut tree.refs, &mut max_depth);
+            params,
+            budget: params.memory_budget_bytes(),
+            used: NODE_BYTES + PENDING_BYTES + REF_BYTES * bounded.len() as u64,
+            nodes: Blocks::new(),
+            refs: Blocks::new(),
+            stats: tree.stats,
+        };
+        builder.nodes.extend(&[Node { first: 0, count: 0 }])?;
+        let root = Pending {
+            slot: 0,
+            min: tree.bounds.min,
+            max: tree.bounds.max,
+            items: bounded,
+            non_separating: 0,
+        };
+        builder.build(root)?;
+        let Builder {
+            nodes, refs, stats, ..
+        } = builder;
+        tree.nodes = nodes.into_vec()?;
+        tree.refs = refs.into_vec()?;
         let leaves = tree.nodes.iter().filter(|n| n.count != INTERIOR).count() as u64;
         let empty = tree.nodes.iter().filter(|n| n.count == 0).count() as u64;
         tree.stats = OctreeStats {
@@ -179,11 +258,11 @@ impl Octree {
             leaves,
             empty_leaves: empty,
             references: tree.refs.len() as u64,
-            max_depth,
             memory_bytes: (tree.nodes.len() * std::mem::size_of::<Node>()
                 + (tree.refs.len() + tree.unbounded.len()) * 4) as u64,
+            ..stats
         };
-        tree
+        Ok(tree)
     }
 
     pub fn stats(&self) -> OctreeStats {
@@ -280,7 +359,7 @@ impl Octree {
         visitor.best
     }
 
-    /// Shapes in the way of a shadow ray over `(0, t_max)`.
+    /// What a shadow ray meets over `(0, t_max)`.
     pub fn occlusion<C: Counter>(
         &self,
         shapes: &[Shape],
@@ -288,26 +367,31 @@ impl Octree {
         ray: &PreparedRay,
         t_max: f64,
         counter: &mut C,
-    ) -> Occlusion {
+    ) -> ShadowCrossings {
         let mut visitor = OcclusionVisitor {
             shapes,
             is_transparent,
             ray,
             t_max,
-            occlusion: Occlusion::Clear,
+            found: ShadowCrossings::default(),
             mailbox: Mailbox::new(),
             counter,
         };
         for &i in &self.unbounded {
-            visitor.counter.intersection_test();
-            if shapes[i as usize].intersect(ray, t_max).is_some()
-                && visitor.occlusion.record(i, is_transparent[i as usize])
-            {
-                return Occlusion::Blocked;
+            if test_occlusion(
+                shapes,
+                is_transparent,
+                i,
+                ray,
+                t_max,
+                &mut visitor.found,
+                visitor.counter,
+            ) {
+                return visitor.found;
             }
         }
         self.traverse(ray, t_max, &mut visitor);
-        visitor.occlusion
+        visitor.found
     }
 
     fn traverse<V: LeafVisitor>(&self, ray: &PreparedRay, t_max: f64, visitor: &mut V) {
@@ -533,7 +617,7 @@ struct OcclusionVisitor<'a, C> {
     is_transparent: &'a [bool],
     ray: &'a PreparedRay,
     t_max: f64,
-    occlusion: Occlusion,
+    found: ShadowCrossings,
     mailbox: Mailbox,
     counter: &'a mut C,
 }
@@ -547,14 +631,16 @@ impl<C: Counter> LeafVisitor for OcclusionVisitor<'_, C> {
     #[inline(always)]
     fn visit_leaf(&mut self, refs: &[u32], _t_exit: f64) -> bool {
         for &i in refs {
-            if self.mailbox.seen(i) {
-                continue;
-            }
-            self.counter.intersection_test();
-            if self.shapes[i as usize]
-                .intersect(self.ray, self.t_max)
-                .is_some()
-                && self.occlusion.record(i, self.is_transparent[i as usize])
+            if !self.mailbox.seen(i)
+                && test_occlusion(
+                    self.shapes,
+                    self.is_transparent,
+                    i,
+                    self.ray,
+                    self.t_max,
+                    &mut self.found,
+                    self.counter,
+                )
             {
                 return true;
             }
@@ -567,101 +653,307 @@ impl<C: Counter> LeafVisitor for OcclusionVisitor<'_, C> {
     }
 }
 
-fn build_node(
-    shapes: &[Shape],
-    items: Vec<u32>,
+/// Bytes one node and one reference take in the built structure.
+const NODE_BYTES: u64 = std::mem::size_of::<Node>() as u64;
+const REF_BYTES: u64 = 4;
+/// What a node waiting for its verdict costs besides its references: the
+/// struct and its heap block's bookkeeping (an allocator's header and
+/// rounding, estimated).
+const PENDING_BYTES: u64 = std::mem::size_of::<Pending>() as u64 + 32;
+/// Consecutive levels a node may split without separating its references
+/// before it stays a leaf: concentric spheres centred on a split point
+/// separate one level further down, coincident triangles never do.
+const MAX_NON_SEPARATING_SPLITS: u8 = 2;
+
+/// A node waiting for its verdict: its slot in `nodes`, its cell, the
+/// shapes whose surface touches it, and how many of its ancestors in a row
+/// split without separating anything.
+struct Pending {
+    slot: u32,
     min: DVec3,
     max: DVec3,
-    depth: u32,
-    params: &OctreeParams,
-) -> BuildNode {
-    if depth >= params.max_depth || items.len() <= params.leaf_size as usize {
-        return BuildNode::Leaf(items);
-    }
-    let mid = centre(min, max);
-    let classify = |child: usize| -> Vec<u32> {
-        let (cmin, cmax) = octant(min, max, mid, child);
-        let cell = Aabb::new(cmin, cmax).padded(CLASSIFY_PAD);
-        items
-            .iter()
-            .copied()
-            .filter(|&i| shapes[i as usize].overlaps_box(&cell))
-            .collect()
-    };
-    let parts: Vec<Vec<u32>> = if items.len() >= PARALLEL_MIN {
-        (0..8).into_par_iter().map(classify).collect()
-    } else {
-        (0..8).map(classify).collect()
-    };
-    if params.cost_driven {
-        // Expected cost of a ray through this node, in intersection tests,
-        // as a leaf and split (children weighted by their relative area).
-        let area = Aabb::new(min, max).surface_area();
-        if area > 0.0 {
-            let leaf_cost = items.len() as f64;
-            let split_cost = TRAVERSAL_COST
-                + (0..8)
-                    .map(|c| {
-                        let (cmin, cmax) = octant(min, max, mid, c);
-                        Aabb::new(cmin, cmax).surface_area() / area * parts[c].len() as f64
-                    })
-                    .sum::<f64>();
-            if split_cost >= leaf_cost {
-                return BuildNode::Leaf(items);
-            }
-        }
-    }
-    drop(items);
-    let build_child = |(c, part): (usize, Vec<u32>)| {
-        let (cmin, cmax) = octant(min, max, mid, c);
-        build_node(shapes, part, cmin, cmax, depth + 1, params)
-    };
-    let total: usize = parts.iter().map(Vec::len).sum();
-    let children: Vec<BuildNode> = if total >= PARALLEL_MIN {
-        parts
-            .into_iter()
-            .enumerate()
-            .collect::<Vec<_>>()
-            .into_par_iter()
-            .map(build_child)
-            .collect()
-    } else {
-        parts.into_iter().enumerate().map(build_child).collect()
-    };
-    let children: Box<[BuildNode; 8]> = match children.into_boxed_slice().try_into() {
-        Ok(c) => c,
-        Err(_) => unreachable!("always eight octants"),
-    };
-    BuildNode::Interior(children)
+    items: Vec<u32>,
+    non_separating: u8,
 }
 
-fn flatten(
-    node: BuildNode,
-    slot: usize,
-    depth: u32,
-    nodes: &mut Vec<Node>,
-    refs: &mut Vec<u32>,
-    max_depth: &mut u32,
-) {
-    *max_depth = (*max_depth).max(depth);
-    match node {
-        BuildNode::Leaf(items) => {
-            nodes[slot] = Node {
-                first: refs.len() as u32,
-                count: items.len() as u32,
-            };
-            refs.extend(items);
+/// What a node's classification proposes.
+enum Proposal {
+    Leaf {
+        by_duplication: bool,
+    },
+    Split {
+        children: Vec<Vec<u32>>,
+        separates: bool,
+    },
+}
+
+/// A growable array kept in fixed-size blocks, so that growing it never
+/// holds the old and the new copy at once (a `Vec` doubling a 200 MB array
+/// briefly needs 600 MB); turned into one exact `Vec` at the end.
+struct Blocks<T> {
+    blocks: Vec<Vec<T>>,
+    len: usize,
+}
+
+const BLOCK: usize = 1 << 16;
+
+impl<T: Copy> Blocks<T> {
+    fn new() -> Self {
+        Self {
+            blocks: Vec::new(),
+            len: 0,
         }
-        BuildNode::Interior(children) => {
-            let first = nodes.len();
-            nodes.resize(first + 8, Node { first: 0, count: 0 });
-            nodes[slot] = Node {
-                first: first as u32,
-                count: INTERIOR,
+    }
+
+    fn extend(&mut self, items: &[T]) -> Result<(), OctreeError> {
+        for &item in items {
+            if self.len.is_multiple_of(BLOCK) {
+                let block = try_with_capacity(BLOCK)?;
+                try_push(&mut self.blocks, block)?;
+            }
+            if let Some(block) = self.blocks.last_mut() {
+                block.push(item);
+            }
+            self.len += 1;
+        }
+        Ok(())
+    }
+
+    fn set(&mut self, index: usize, item: T) {
+        self.blocks[index / BLOCK][index % BLOCK] = item;
+    }
+
+    /// One exact `Vec`, freeing each block once copied.
+    fn into_vec(self) -> Result<Vec<T>, OctreeError> {
+        let mut out = try_with_capacity(self.len)?;
+        for block in self.blocks {
+            out.extend_from_slice(&block);
+        }
+        Ok(out)
+    }
+}
+
+struct Builder<'a> {
+    shapes: &'a [Shape],
+    params: OctreeParams,
+    budget: u64,
+    /// Bytes held so far: the structure built, plus the nodes waiting for
+    /// their verdict with their references.
+    used: u64,
+    nodes: Blocks<Node>,
+    refs: Blocks<u32>,
+    stats: OctreeStats,
+}
+
+/// Grows `v` by one element without aborting when memory runs out.
+fn try_push<T>(v: &mut Vec<T>, item: T) -> Result<(), OctreeError> {
+    v.try_reserve(1).map_err(|_| OctreeError::OutOfMemory {
+        bytes: (v.capacity().max(1) * std::mem::size_of::<T>()) as u64,
+    })?;
+    v.push(item);
+    Ok(())
+}
+
+fn try_with_capacity<T>(n: usize) -> Result<Vec<T>, OctreeError> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(n)
+        .map_err(|_| OctreeError::OutOfMemory {
+            bytes: (n * std::mem::size_of::<T>()) as u64,
+        })?;
+    Ok(v)
+}
+
+impl Builder<'_> {
+    /// Builds level by level from `root`.
+    fn build(&mut self, root: Pending) -> Result<(), OctreeError> {
+        let mut level = vec![root];
+        let mut depth = 0;
+        while !level.is_empty() {
+            self.stats.max_depth = depth;
+            let mut next = Vec::new();
+            let mut rest = level.into_iter().peekable();
+            while rest.peek().is_some() {
+                // A batch of nodes, classified in parallel, decided in order.
+                let mut batch = Vec::new();
+                let mut references = 0;
+                while let Some(p) = rest.next_if(|_| references < BATCH_REFERENCES) {
+                    references += p.items.len();
+                    batch.push(p);
+                }
+                let proposals: Vec<Result<Proposal, OctreeError>> =
+                    batch.par_iter().map(|p| self.propose(p, depth)).collect();
+                for (pending, proposal) in batch.into_iter().zip(proposals) {
+                    self.decide(pending, proposal?, &mut next)?;
+                }
+            }
+            level = next;
+            depth += 1;
+        }
+        Ok(())
+    }
+
+    /// Whether `p`, at level `depth`, should split and into what.
+    fn propose(&self, p: &Pending, depth: u32) -> Result<Proposal, OctreeError> {
+        let n = p.items.len();
+        let params = &self.params;
+        let leaf = Proposal::Leaf {
+            by_duplication: false,
+        };
+        // The smallest possible split (eight empty children) must fit.
+        if depth >= params.max_depth
+            || n <= params.leaf_size as usize
+            || self.used + 8 * NODE_BYTES > self.budget
+        {
+            return Ok(leaf);
+        }
+        let mid = centre(p.min, p.max);
+        let cells: [Aabb; 8] = std::array::from_fn(|c| {
+            let (cmin, cmax) = octant(p.min, p.max, mid, c);
+            Aabb::new(cmin, cmax).padded(CLASSIFY_PAD)
+        });
+        // One byte per reference: the octants its surface touches. The
+        // bounding box rules out octants cheaply; the exact test runs only
+        // where the box spans several. A shape whose box meets a single
+        // octant touches it (its surface touches this node), or at worst
+        // only the padding: an extra reference, never a missing one.
+        let mask_of = |&i: &u32| -> u8 {
+            let shape = &self.shapes[i as usize];
+            let candidates = match shape.bounds() {
+                Some(b) => (0..8).fold(0u8, |m, c| m | ((b.overlaps(&cells[c]) as u8) << c)),
+                None => 0xff,
             };
-            for (c, child) in (*children).into_iter().enumerate() {
-                flatten(child, first + c, depth + 1, nodes, refs, max_depth);
+            if candidates.count_ones() <= 1 {
+                return candidates;
+            }
+            (0..8).fold(0u8, |m, c| {
+                let touches = candidates >> c & 1 == 1 && shape.overlaps_box(&cells[c]);
+                m | ((touches as u8) << c)
+            })
+        };
+        let mut masks = try_with_capacity::<u8>(n)?;
+        if n >= PARALLEL_MIN {
+            p.items.par_iter().map(mask_of).collect_into_vec(&mut masks);
+        } else {
+            masks.extend(p.items.iter().map(mask_of));
+        }
+        let mut counts = [0usize; 8];
+        for m in &masks {
+            for (c, count) in counts.iter_mut().enumerate() {
+                *count += (m >> c & 1) as usize;
             }
         }
+        let total: usize = counts.iter().sum();
+        // A split separates unless several children each hold every
+        // reference (one child holding them all still shrinks the cell).
+        let occupied = counts.iter().filter(|&&k| k > 0).count();
+        let separates = occupied == 1 || counts.iter().any(|&k| k > 0 && k < n);
+        let stale = !separates && p.non_separating + 1 > MAX_NON_SEPARATING_SPLITS;
+        if stale || total > params.max_duplication as usize * n {
+            return Ok(Proposal::Leaf {
+                by_duplication: true,
+            });
+        }
+        if params.cost_driven {
+            // Expected cost of a ray through this node, in intersection tests,
+            // as a leaf and split (children weighted by their relative area).
+            let area = Aabb::new(p.min, p.max).surface_area();
+            if area > 0.0 {
+                let split_cost = TRAVERSAL_COST
+                    + (0..8)
+                        .map(|c| {
+                            let (cmin, cmax) = octant(p.min, p.max, mid, c);
+                            Aabb::new(cmin, cmax).surface_area() / area * counts[c] as f64
+                        })
+                        .sum::<f64>();
+                if split_cost >= n as f64 {
+                    return Ok(leaf);
+                }
+            }
+        }
+        let mut children = try_with_capacity::<Vec<u32>>(8)?;
+        for &count in &counts {
+            children.push(try_with_capacity(count)?);
+        }
+        for (&i, &m) in p.items.iter().zip(&masks) {
+            for (c, child) in children.iter_mut().enumerate() {
+                if m >> c & 1 == 1 {
+                    child.push(i);
+                }
+            }
+        }
+        Ok(Proposal::Split {
+            children,
+            separates,
+        })
+    }
+
+    /// Makes `p` a leaf, or splits it if its proposal fits the budget,
+    /// queueing its non-empty children on `next`.
+    fn decide(
+        &mut self,
+        p: Pending,
+        proposal: Proposal,
+        next: &mut Vec<Pending>,
+    ) -> Result<(), OctreeError> {
+        let held = PENDING_BYTES + REF_BYTES * p.items.len() as u64;
+        match proposal {
+            Proposal::Split {
+                children,
+                separates,
+            } => {
+                let queued: u64 = children
+                    .iter()
+                    .filter(|c| !c.is_empty())
+                    .map(|c| PENDING_BYTES + REF_BYTES * c.len() as u64)
+                    .sum();
+                let after = self.used - held + 8 * NODE_BYTES + queued;
+                if after <= self.budget {
+                    self.used = after;
+                    let first = self.nodes.len;
+                    self.nodes.extend(&[Node { first: 0, count: 0 }; 8])?;
+                    self.nodes.set(
+                        p.slot as usize,
+                        Node {
+                            first: first as u32,
+                            count: INTERIOR,
+                        },
+                    );
+                    let mid = centre(p.min, p.max);
+                    let non_separating = if separates { 0 } else { p.non_separating + 1 };
+                    for (c, items) in children.into_iter().enumerate() {
+                        // Empty children are finished leaves already.
+                        if items.is_empty() {
+                            continue;
+                        }
+                        let (min, max) = octant(p.min, p.max, mid, c);
+                        try_push(
+                            next,
+                            Pending {
+                                slot: (first + c) as u32,
+                                min,
+                                max,
+                                items,
+                                non_separating,
+                            },
+                        )?;
+                    }
+                    return Ok(());
+                }
+                self.stats.leaves_stopped_by_budget += 1;
+            }
+            Proposal::Leaf { by_duplication } => {
+                self.stats.leaves_stopped_by_duplication += by_duplication as u64;
+            }
+        }
+        self.nodes.set(
+            p.slot as usize,
+            Node {
+                first: self.refs.len as u32,
+                count: p.items.len() as u32,
+            },
+        );
+        self.refs.extend(&p.items)?;
+        self.used -= PENDING_BYTES;
+        Ok(())
     }
 }

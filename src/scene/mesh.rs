@@ -2,6 +2,7 @@
 
 use std::path::Path;
 
+use super::polygon::{DroppedPolygons, triangulate};
 use crate::math::DVec3;
 
 /// Where mesh files come from: the file system, or memory for scenes
@@ -40,6 +41,8 @@ pub struct LoadedMesh {
     pub triangles: Vec<[DVec3; 3]>,
     /// Per-triangle vertex normals when the mesh is smooth shaded.
     pub normals: Option<Vec<[DVec3; 3]>>,
+    /// Faces that were not simple polygons or had no area.
+    pub dropped_polygons: DroppedPolygons,
 }
 
 /// Parses OBJ bytes. `smooth`: `None` uses the file's normals when it has
@@ -50,9 +53,14 @@ pub fn parse_obj(
     smooth: Option<bool>,
     placement: &Placement,
 ) -> Result<LoadedMesh, String> {
+    // tobj's own triangulation splits quads on a fixed diagonal and larger
+    // faces as a fan, which is wrong for concave faces: faces are read
+    // whole and ear-clipped here.
     let options = tobj::LoadOptions {
-        triangulate: true,
+        triangulate: false,
         single_index: true,
+        ignore_points: true,
+        ignore_lines: true,
         ..Default::default()
     };
     let mut reader = std::io::BufReader::new(bytes);
@@ -63,6 +71,7 @@ pub fn parse_obj(
     let mut triangles = Vec::new();
     let mut normals = Vec::new();
     let mut any_normals = false;
+    let mut dropped_polygons = DroppedPolygons::default();
     for model in &models {
         let m = &model.mesh;
         let position = |i: u32| -> Result<DVec3, String> {
@@ -74,34 +83,63 @@ pub fn parse_obj(
         };
         let has_normals = m.normals.len() == m.positions.len() && !m.normals.is_empty();
         any_normals |= has_normals;
-        for face in m.indices.chunks_exact(3) {
-            let tri = [
-                place(position(face[0])?),
-                place(position(face[1])?),
-                place(position(face[2])?),
-            ];
-            if !tri.iter().all(|p| p.is_finite()) {
+        let normal = |i: u32| {
+            let i = i as usize * 3;
+            rotation
+                * DVec3::new(
+                    m.normals[i] as f64,
+                    m.normals[i + 1] as f64,
+                    m.normals[i + 2] as f64,
+                )
+        };
+        // Every face is a triangle when the file has no larger ones.
+        let arities: Vec<usize> = if m.face_arities.is_empty() {
+            vec![3; m.indices.len() / 3]
+        } else {
+            m.face_arities.iter().map(|&a| a as usize).collect()
+        };
+        let mut start = 0;
+        for arity in arities {
+            let face = m
+                .indices
+                .get(start..start + arity)
+                .ok_or("face indices out of range")?;
+            start += arity;
+            let corners = face
+                .iter()
+                .map(|&i| position(i).map(place))
+                .collect::<Result<Vec<DVec3>, String>>()?;
+            if !corners.iter().all(|p| p.is_finite()) {
                 return Err("vertex coordinates must be finite".into());
             }
-            triangles.push(tri);
-            if has_normals {
-                let n = |i: u32| {
-                    let i = i as usize * 3;
-                    rotation
-                        * DVec3::new(
-                            m.normals[i] as f64,
-                            m.normals[i + 1] as f64,
-                            m.normals[i + 2] as f64,
-                        )
-                };
-                normals.push([n(face[0]), n(face[1]), n(face[2])]);
+            let pieces = if arity == 3 {
+                vec![[0, 1, 2]]
             } else {
-                normals.push([DVec3::ZERO; 3]);
+                match triangulate(&corners) {
+                    Ok(t) => t,
+                    Err(defect) => {
+                        dropped_polygons.record(defect);
+                        continue;
+                    }
+                }
+            };
+            for [a, b, c] in pieces {
+                let (a, b, c) = (a as usize, b as usize, c as usize);
+                triangles.push([corners[a], corners[b], corners[c]]);
+                normals.push(if has_normals {
+                    [normal(face[a]), normal(face[b]), normal(face[c])]
+                } else {
+                    [DVec3::ZERO; 3]
+                });
             }
         }
     }
     if triangles.is_empty() {
-        return Err("the mesh has no triangles".into());
+        return Err(if dropped_polygons.total() > 0 {
+            "the mesh has no face that is a simple polygon".into()
+        } else {
+            "the mesh has no triangles".into()
+        });
     }
     let normals = match smooth {
         Some(false) => None,
@@ -109,7 +147,11 @@ pub fn parse_obj(
         Some(true) if !any_normals => Some(computed_vertex_normals(&triangles)),
         _ => Some(normals),
     };
-    Ok(LoadedMesh { triangles, normals })
+    Ok(LoadedMesh {
+        triangles,
+        normals,
+        dropped_polygons,
+    })
 }
 
 /// Area-weighted vertex normals for a triangle soup, vertices matched by
@@ -155,7 +197,33 @@ mod tests {
         assert_eq!(mesh.triangles.len(), 2);
         assert!(mesh.normals.is_none());
         // (1,0,0) scaled to (2,0,0), rotated 90 degrees about z to (0,2,0).
-        assert!((mesh.triangles[0][1] - DVec3::new(0.0, 2.0, 5.0)).length() < 1e-12);
+        let placed = DVec3::new(0.0, 2.0, 5.0);
+        assert!(
+            mesh.triangles
+                .iter()
+                .flatten()
+                .any(|v| (*v - placed).length() < 1e-12)
+        );
+    }
+
+    #[test]
+    fn concave_faces_are_ear_clipped_not_fanned() {
+        // An arrow head given from its reflex vertex: tobj's fixed diagonal
+        // (1-3) and a fan from vertex 1 would both fill outside it.
+        let arrow = "v 2 1 0\nv 4 0 0\nv 2 3 0\nv 0 0 0\nf 1 2 3 4\n";
+        let mesh = parse_obj(arrow.as_bytes(), None, &identity()).unwrap();
+        let area: f64 = mesh
+            .triangles
+            .iter()
+            .map(|[a, b, c]| 0.5 * (*b - *a).cross(*c - *a).z)
+            .sum();
+        assert_eq!(mesh.triangles.len(), 2);
+        // Shoelace area of the outline: 4.
+        assert!((area - 4.0).abs() < 1e-12, "area {area}");
+        let bow_tie = "v 0 0 0\nv 1 1 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 4\nf 1 3 2\n";
+        let mesh = parse_obj(bow_tie.as_bytes(), None, &identity()).unwrap();
+        assert_eq!(mesh.triangles.len(), 1);
+        assert_eq!(mesh.dropped_polygons.not_simple, 1);
     }
 
     #[test]

@@ -4,6 +4,7 @@
 pub mod builtin;
 mod mesh;
 pub mod nff;
+pub mod polygon;
 pub mod toml_format;
 
 use std::path::{Path, PathBuf};
@@ -12,7 +13,9 @@ use crate::accel::OctreeParams;
 use crate::camera::CameraSpec;
 use crate::material::{Light, Material};
 use crate::math::{Aabb, Color, DVec3};
-use crate::shapes::Shape;
+use crate::shapes::{Shape, Triangle};
+
+pub use polygon::DroppedPolygons;
 
 /// Image and recursion settings stored with a scene; command-line flags and
 /// the viewer override them.
@@ -59,24 +62,109 @@ pub struct Scene {
     pub vertex_normals: Vec<[DVec3; 3]>,
     /// Degenerate triangles dropped while loading (they could never be hit).
     pub dropped_triangles: usize,
+    /// Polygons dropped while loading: zero area, or not simple.
+    pub dropped_polygons: DroppedPolygons,
     /// The text the scene was parsed from, kept for reproducible exports
     /// (empty for scenes built in code).
     pub source_text: String,
 }
 
 impl Scene {
+    /// A scene with no materials, lights or shapes yet.
+    pub fn empty(name: String, camera: CameraSpec, image: ImageSettings) -> Self {
+        Self {
+            name,
+            camera,
+            image,
+            octree_enabled: true,
+            octree_params: OctreeParams::default(),
+            materials: Vec::new(),
+            lights: Vec::new(),
+            shapes: Vec::new(),
+            shape_materials: Vec::new(),
+            vertex_normals: Vec::new(),
+            dropped_triangles: 0,
+            dropped_polygons: DroppedPolygons::default(),
+            source_text: String::new(),
+        }
+    }
+
     pub fn push(&mut self, shape: Shape, material: u32) {
         self.shapes.push(shape);
         self.shape_materials.push(material);
     }
 
-    /// Bounds of every bounded shape, the lights and the eye: the magnitude
-    /// of the numbers the renderer works with.
+    /// Adds triangles (with optional per-triangle vertex normals), dropping
+    /// degenerate ones.
+    pub(crate) fn push_mesh(
+        &mut self,
+        triangles: Vec<[DVec3; 3]>,
+        normals: Option<Vec<[DVec3; 3]>>,
+        material: u32,
+    ) {
+        for (i, vertices) in triangles.into_iter().enumerate() {
+            self.push_triangle(vertices, normals.as_ref().map(|n| n[i]), material);
+        }
+    }
+
+    /// Adds one triangle, or counts it as dropped if it is degenerate.
+    fn push_triangle(&mut self, vertices: [DVec3; 3], normals: Option<[DVec3; 3]>, material: u32) {
+        let Some(mut t) = Triangle::new(vertices) else {
+            self.dropped_triangles += 1;
+            return;
+        };
+        if let Some(n) = normals
+            && n.iter().all(|v| v.is_finite() && v.length_squared() > 0.0)
+        {
+            t.vertex_normals = self.vertex_normals.len() as u32;
+            self.vertex_normals.push(n);
+        }
+        self.push(Shape::Triangle(t), material);
+    }
+
+    /// Adds a planar polygon (any simple outline, convex or not, either
+    /// winding) as the triangles of its ear-clipping triangulation, with
+    /// its vertex normals if given; a polygon of zero area or that is not
+    /// simple is dropped and counted in [`Scene::dropped_polygons`].
+    pub(crate) fn push_polygon(
+        &mut self,
+        vertices: &[DVec3],
+        normals: Option<&[DVec3]>,
+        material: u32,
+    ) {
+        match polygon::triangulate(vertices) {
+            Ok(triangles) => {
+                for t in triangles {
+                    let [a, b, c] = t.map(|i| i as usize);
+                    self.push_triangle(
+                        [vertices[a], vertices[b], vertices[c]],
+                        normals.map(|n| [n[a], n[b], n[c]]),
+                        material,
+                    );
+                }
+            }
+            Err(defect) => self.dropped_polygons.record(defect),
+        }
+    }
+
+    /// Bounds of every bounded shape, the lights and the eye: the region a
+    /// user looks at and moves about in.
     pub fn extent_bounds(&self) -> Aabb {
-        let mut b = Aabb::EMPTY.grow(self.camera.eye).grow(self.camera.lookat);
+        let mut b = self
+            .geometry_bounds()
+            .grow(self.camera.eye)
+            .grow(self.camera.lookat);
         for light in &self.lights {
             b = b.grow(light.position);
         }
+        b
+    }
+
+    /// Bounds of every bounded shape and a point of every plane: the
+    /// magnitude of the surface points the renderer computes. (A light far
+    /// away does not make them any less precise.)
+    pub fn geometry_bounds(&self) -> Aabb {
+        let mut b = Aabb::EMPTY;
         for shape in &self.shapes {
             match shape {
                 Shape::Plane(p) => b = b.grow(p.point),

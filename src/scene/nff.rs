@@ -5,9 +5,13 @@
 use std::path::Path;
 
 use super::{ImageSettings, Location, Scene, SceneError};
-use crate::accel::OctreeParams;
 use crate::camera::CameraSpec;
-use crate::material::{Light, Material};
+use std::ops::RangeInclusive;
+
+use crate::material::{
+    INTENSITY_RANGE, IOR_RANGE, Light, Material, SHININESS_RANGE, UNIT_RANGE, check_color,
+    check_range,
+};
 use crate::math::DVec3;
 use crate::shapes::{Cone, Shape, Sphere};
 
@@ -111,6 +115,29 @@ impl<'a> Tokens<'a> {
         ))
     }
 
+    /// A number in `range`; errors point at the number.
+    fn number_in(&mut self, what: &str, range: &RangeInclusive<f64>) -> Result<f64, SceneError> {
+        let (line, column) = self.peek_place();
+        let x = self.number(what)?;
+        check_range(x, range)
+            .map_err(|e| self.error_at(line, column, self.entity.2, format!("{what} {e}")))
+    }
+
+    /// Three numbers in `range`; errors point at the first.
+    fn color_in(&mut self, what: &str, range: &RangeInclusive<f64>) -> Result<DVec3, SceneError> {
+        let (line, column) = self.peek_place();
+        let c = self.vec3(what)?;
+        check_color(c, range)
+            .map_err(|e| self.error_at(line, column, self.entity.2, format!("{what}: {e}")))
+    }
+
+    /// Line and column of the next token (or of the entity, at the end).
+    fn peek_place(&self) -> (usize, usize) {
+        self.tokens
+            .get(self.next)
+            .map_or((self.entity.0, self.entity.1), |t| (t.line, t.column))
+    }
+
     fn count(&mut self, what: &str, max: usize) -> Result<usize, SceneError> {
         let key = self.entity.2;
         let t = self.next_token(what)?;
@@ -179,25 +206,16 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
     };
     // Lights given without a colour; their intensity depends on the final count.
     let mut uncoloured_lights = Vec::new();
-    let mut scene = Scene {
-        name: path.display().to_string(),
-        camera: CameraSpec {
+    let mut scene = Scene::empty(
+        path.display().to_string(),
+        CameraSpec {
             eye: DVec3::ZERO,
             lookat: DVec3::NEG_Z,
             up: DVec3::Y,
             fov: 45.0,
         },
-        image: image.clone(),
-        octree_enabled: true,
-        octree_params: OctreeParams::default(),
-        materials: Vec::new(),
-        lights: Vec::new(),
-        shapes: Vec::new(),
-        shape_materials: Vec::new(),
-        vertex_normals: Vec::new(),
-        dropped_triangles: 0,
-        source_text: String::new(),
-    };
+        image.clone(),
+    );
     let mut material: Option<u32> = None;
 
     while tokens.next < tokens.tokens.len() {
@@ -256,7 +274,10 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
                     fov: fov_from_nff_angle(angle, h as u32),
                 });
             }
-            "b" => image.background = srgb_to_linear(tokens.vec3("background colour")?),
+            "b" => {
+                image.background =
+                    srgb_to_linear(tokens.color_in("background colour", &UNIT_RANGE)?)
+            }
             "l" => {
                 let position = tokens.vec3("light position")?;
                 // The colour is optional: it is present if the next token is a number.
@@ -265,7 +286,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
                     .get(tokens.next)
                     .is_some_and(|t| t.text.parse::<f64>().is_ok());
                 if has_colour {
-                    let color = tokens.vec3("light colour")?.max(DVec3::ZERO);
+                    let color = tokens.color_in("light colour", &INTENSITY_RANGE)?;
                     scene.lights.push(Light { position, color });
                 } else {
                     uncoloured_lights.push(scene.lights.len());
@@ -276,13 +297,21 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 }
             }
             "f" => {
-                let color = srgb_to_linear(tokens.vec3("colour")?);
-                let kd = tokens.number("Kd")?.max(0.0);
-                let ks = tokens.number("Ks")?.max(0.0);
-                let shininess = tokens.number("Shine")?.max(0.0);
-                let transparency = tokens.number("T")?.max(0.0);
+                let color = srgb_to_linear(tokens.color_in("colour", &UNIT_RANGE)?);
+                let kd = tokens.number_in("Kd", &UNIT_RANGE)?;
+                let ks = tokens.number_in("Ks", &UNIT_RANGE)?;
+                let shininess = tokens.number_in("Shine", &SHININESS_RANGE)?;
+                let transparency = tokens.number_in("T", &UNIT_RANGE)?;
+                let (line, column) = tokens.peek_place();
                 let ior = tokens.number("index of refraction")?;
-                let ior = if ior > 0.0 { ior } else { 1.0 };
+                // Opaque materials often give 0 (the SPD's gears do): it is unused.
+                let ior = if transparency > 0.0 {
+                    check_range(ior, &IOR_RANGE).map_err(|e| {
+                        tokens.error_at(line, column, "f", format!("index of refraction {e}"))
+                    })?
+                } else {
+                    1.0
+                };
                 let m = Material {
                     name: format!("f{}", scene.materials.len() + 1),
                     color,
@@ -352,18 +381,9 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
                     }
                 }
                 let m = needs_material(material, &tokens)?;
-                // Convex polygons: a fan from the first vertex.
-                let triangles: Vec<[DVec3; 3]> = (1..n - 1)
-                    .map(|i| [vertices[0], vertices[i], vertices[i + 1]])
-                    .collect();
-                let tri_normals = with_normals.then(|| {
-                    (1..n - 1)
-                        .map(|i| {
-                            [normals[0], normals[i], normals[i + 1]].map(|v| v.normalize_or_zero())
-                        })
-                        .collect()
-                });
-                super::toml_format::push_mesh(&mut scene, triangles, tri_normals, m);
+                let normals: Vec<DVec3> = normals.iter().map(|v| v.normalize_or_zero()).collect();
+                // Concave outlines are common (gear faces): ear clipping, not a fan.
+                scene.push_polygon(&vertices, with_normals.then_some(&normals[..]), m);
             }
             other => {
                 return Err(tokens.error_at(
@@ -499,6 +519,26 @@ pp 3
                 "c 0 0 0 1 0 1 0 0.5",
                 "c 0 0 0 1 0 0 0 0.5",
                 "t.nff:14:1: `c`: cone base and apex coincide",
+            ),
+            (
+                "f 1 0.5 0.2 0.7",
+                "f 1 0.5 0.2 1e300",
+                "t.nff:12:13: `f`: Kd must lie in [0, 1], got 1e300",
+            ),
+            (
+                "f 1 0.5 0.2 0.7",
+                "f 1 -0.5 0.2 0.7",
+                "t.nff:12:3: `f`: colour: each component must lie in [0, 1]",
+            ),
+            (
+                "0.3 20 0 1",
+                "0.3 20 0.5 0",
+                "t.nff:12:28: `f`: index of refraction must lie in [0.01, 100], got 0",
+            ),
+            (
+                "l -5 5 5 1 0 0",
+                "l -5 5 5 3.4e38 0 0",
+                "t.nff:11:10: `l`: light colour: each component must lie in [0, 1000]",
             ),
         ];
         for (from, to, expected) in cases {

@@ -1,7 +1,7 @@
 //! glint's own scene format; every key is documented in `scenes/README.md`.
 
 use std::collections::BTreeMap;
-use std::ops::Range;
+use std::ops::{Range, RangeInclusive};
 use std::path::Path;
 
 use serde::Deserialize;
@@ -11,7 +11,10 @@ use super::mesh::{MeshSource, Placement, parse_obj};
 use super::{ImageSettings, Location, Scene, SceneError};
 use crate::accel::OctreeParams;
 use crate::camera::CameraSpec;
-use crate::material::{Light, Material};
+use crate::material::{
+    INTENSITY_RANGE, IOR_RANGE, Light, Material, SHININESS_RANGE, UNIT_RANGE, check_color,
+    check_range,
+};
 use crate::math::{Aabb, DVec3};
 use crate::shapes::{Plane, Quadric, Shape, Sphere, Triangle};
 
@@ -59,6 +62,8 @@ struct OctreeFile {
     enabled: Option<bool>,
     max_depth: Option<Spanned<i64>>,
     leaf_size: Option<Spanned<i64>>,
+    max_duplication: Option<Spanned<i64>>,
+    memory_budget_mib: Option<Spanned<i64>>,
 }
 
 #[derive(Deserialize)]
@@ -153,20 +158,21 @@ impl Context<'_> {
         }
     }
 
-    fn color(&self, v: &Vec3, key: &str) -> Result<DVec3, SceneError> {
+    /// A colour whose components lie in `range` (surface colours in
+    /// [0, 1], intensities in [0, 1000]).
+    fn color(&self, v: &Vec3, key: &str, range: &RangeInclusive<f64>) -> Result<DVec3, SceneError> {
         let c = self.vec3(v, key)?;
-        if c.min_element() < 0.0 {
-            return Err(self.error(v.span(), key, "colour components must not be negative"));
-        }
-        Ok(c)
+        check_color(c, range).map_err(|e| self.error(v.span(), key, e))
     }
 
-    fn non_negative(&self, v: &Spanned<f64>, key: &str) -> Result<f64, SceneError> {
+    fn in_range(
+        &self,
+        v: &Spanned<f64>,
+        key: &str,
+        range: &RangeInclusive<f64>,
+    ) -> Result<f64, SceneError> {
         let x = self.finite(v, key)?;
-        if x < 0.0 {
-            return Err(self.error(v.span(), key, format!("must not be negative, got {x}")));
-        }
-        Ok(x)
+        check_range(x, range).map_err(|e| self.error(v.span(), key, e))
     }
 
     fn integer(&self, v: &Spanned<i64>, key: &str, range: Range<i64>) -> Result<u32, SceneError> {
@@ -232,10 +238,10 @@ pub fn parse(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, S
         image.max_depth = cx.integer(v, "image.max_depth", 1..MAX_DEPTH_LIMIT + 1)?;
     }
     if let Some(v) = &im.background {
-        image.background = cx.color(v, "image.background")?;
+        image.background = cx.color(v, "image.background", &INTENSITY_RANGE)?;
     }
     if let Some(v) = &im.ambient {
-        image.ambient = cx.color(v, "image.ambient")?;
+        image.ambient = cx.color(v, "image.ambient", &INTENSITY_RANGE)?;
     }
 
     let mut octree_params = OctreeParams::default();
@@ -249,6 +255,16 @@ pub fn parse(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, S
     if let Some(v) = &file.octree.leaf_size {
         octree_params.leaf_size = cx.integer(v, "octree.leaf_size", 1..1_000_001)?;
     }
+    if let Some(v) = &file.octree.max_duplication {
+        octree_params.max_duplication = cx.integer(v, "octree.max_duplication", 1..9)?;
+    }
+    if let Some(v) = &file.octree.memory_budget_mib {
+        octree_params.memory_budget_mib = cx.integer(
+            v,
+            "octree.memory_budget_mib",
+            1..crate::accel::MAX_MEMORY_BUDGET_MIB as i64 + 1,
+        )?;
+    }
 
     let mut materials = Vec::new();
     for (name, m) in &file.materials {
@@ -258,23 +274,33 @@ pub fn parse(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, S
             ..Material::default()
         };
         if let Some(v) = &m.color {
-            mat.color = cx.color(v, &key("color"))?;
+            mat.color = cx.color(v, &key("color"), &UNIT_RANGE)?;
         }
-        for (slot, value, k) in [
-            (&mut mat.kd, &m.kd, "kd"),
-            (&mut mat.ks, &m.ks, "ks"),
-            (&mut mat.shininess, &m.shininess, "shininess"),
-            (&mut mat.reflectivity, &m.reflectivity, "reflectivity"),
-            (&mut mat.transparency, &m.transparency, "transparency"),
+        for (slot, value, k, range) in [
+            (&mut mat.kd, &m.kd, "kd", &UNIT_RANGE),
+            (&mut mat.ks, &m.ks, "ks", &UNIT_RANGE),
+            (
+                &mut mat.shininess,
+                &m.shininess,
+                "shininess",
+                &SHININESS_RANGE,
+            ),
+            (
+                &mut mat.reflectivity,
+                &m.reflectivity,
+                "reflectivity",
+                &UNIT_RANGE,
+            ),
+            (
+                &mut mat.transparency,
+                &m.transparency,
+                "transparency",
+                &UNIT_RANGE,
+            ),
+            (&mut mat.ior, &m.ior, "ior", &IOR_RANGE),
         ] {
             if let Some(v) = value {
-                *slot = cx.non_negative(v, &key(k))?;
-            }
-        }
-        if let Some(v) = &m.ior {
-            mat.ior = cx.finite(v, &key("ior"))?;
-            if mat.ior <= 0.0 {
-                return Err(cx.error(v.span(), &key("ior"), "must be positive"));
+                *slot = cx.in_range(v, &key(k), range)?;
             }
         }
         materials.push(mat);
@@ -285,26 +311,17 @@ pub fn parse(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, S
         lights.push(Light {
             position: cx.vec3(&l.position, &format!("lights[{i}].position"))?,
             color: match &l.color {
-                Some(c) => cx.color(c, &format!("lights[{i}].color"))?,
+                Some(c) => cx.color(c, &format!("lights[{i}].color"), &INTENSITY_RANGE)?,
                 None => DVec3::ONE,
             },
         });
     }
 
-    let mut scene = Scene {
-        name: path.display().to_string(),
-        camera,
-        image,
-        octree_enabled: file.octree.enabled.unwrap_or(true),
-        octree_params,
-        materials,
-        lights,
-        shapes: Vec::new(),
-        shape_materials: Vec::new(),
-        vertex_normals: Vec::new(),
-        dropped_triangles: 0,
-        source_text: String::new(),
-    };
+    let mut scene = Scene::empty(path.display().to_string(), camera, image);
+    scene.octree_enabled = file.octree.enabled.unwrap_or(true);
+    scene.octree_params = octree_params;
+    scene.materials = materials;
+    scene.lights = lights;
     for (i, obj) in file.objects.iter().enumerate() {
         add_object(&cx, &mut scene, i, obj, files)?;
     }
@@ -504,34 +521,13 @@ fn add_object(
                 &placement,
             )
             .map_err(mesh_error)?;
-            push_mesh(scene, mesh.triangles, mesh.normals, material);
+            scene.dropped_polygons.zero_area += mesh.dropped_polygons.zero_area;
+            scene.dropped_polygons.not_simple += mesh.dropped_polygons.not_simple;
+            scene.push_mesh(mesh.triangles, mesh.normals, material);
         }
         _ => unreachable!("kinds were checked above"),
     }
     Ok(())
-}
-
-/// Adds triangles (with optional per-triangle vertex normals), dropping
-/// degenerate ones.
-pub(crate) fn push_mesh(
-    scene: &mut Scene,
-    triangles: Vec<[DVec3; 3]>,
-    normals: Option<Vec<[DVec3; 3]>>,
-    material: u32,
-) {
-    for (i, vertices) in triangles.into_iter().enumerate() {
-        let Some(mut t) = Triangle::new(vertices) else {
-            scene.dropped_triangles += 1;
-            continue;
-        };
-        if let Some(n) = normals.as_ref().map(|n| n[i])
-            && n.iter().all(|v| v.is_finite() && v.length_squared() > 0.0)
-        {
-            t.vertex_normals = scene.vertex_normals.len() as u32;
-            scene.vertex_normals.push(n);
-        }
-        scene.push(Shape::Triangle(t), material);
-    }
 }
 
 /// The dotted key path at a byte offset, found from the table header and the
@@ -680,7 +676,17 @@ radius = 1
             (
                 "color = [1, 0, 0]",
                 "color = [1, -1, 0]",
-                "test.toml:9:9: `materials.red.color`: colour components",
+                "test.toml:9:9: `materials.red.color`: each component must lie in [0, 1]",
+            ),
+            (
+                "color = [1, 0, 0]",
+                "color = [1e300, 0, 0]",
+                "test.toml:9:9: `materials.red.color`: each component must lie in [0, 1]",
+            ),
+            (
+                "color = [1, 0, 0]",
+                "color = [1, 0, 0]\nreflectivity = 1e300",
+                "test.toml:10:16: `materials.red.reflectivity`: must lie in [0, 1], got 1e300",
             ),
             (
                 "radius = 1",

@@ -1,4 +1,4 @@
-use super::{ShapeHit, Surface};
+use super::{Crossings, ShapeHit, Surface};
 use crate::math::{Aabb, DVec3, Ray, solve_quadratic_half};
 
 /// Open truncated cone (or cylinder) between two disks, without end caps:
@@ -43,8 +43,10 @@ impl Cone {
     /// Points `q` (relative to `base`) satisfy `|q_perp|^2 = (r0 + s z)^2`
     /// with `z = q . axis`; the perpendicular parts are formed explicitly so
     /// nothing cancels for rays that start far away.
+    /// The parameters where the ray's line meets the infinite cone, smaller
+    /// first, and a test of whether a parameter lies on the finite part.
     #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<ShapeHit> {
+    fn roots(&self, ray: &Ray) -> Option<((f64, f64), impl Fn(f64) -> bool)> {
         let o = ray.origin - self.base;
         let (oz, dz) = (o.dot(self.axis), ray.dir.dot(self.axis));
         let o_perp = o - oz * self.axis;
@@ -53,18 +55,37 @@ impl Cone {
         let a = d_perp.length_squared() - self.slope * self.slope * dz * dz;
         let h = o_perp.dot(d_perp) - self.slope * dz * r_o;
         let c = o_perp.length_squared() - r_o * r_o;
-        let (t0, t1) = solve_quadratic_half(a, h, c)?;
+        let roots = solve_quadratic_half(a, h, c)?;
+        let (height, base_radius, slope) = (self.height, self.base_radius, self.slope);
+        let on_part = move |t: f64| {
+            let z = oz + t * dz;
+            z >= 0.0 && z <= height && base_radius + slope * z >= 0.0
+        };
+        Some((roots, on_part))
+    }
+
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<ShapeHit> {
+        let ((t0, t1), on_part) = self.roots(ray)?;
         [t0, t1]
             .into_iter()
-            .find(|&t| {
-                let z = oz + t * dz;
-                t > 0.0
-                    && t < t_max
-                    && z >= 0.0
-                    && z <= self.height
-                    && self.base_radius + self.slope * z >= 0.0
-            })
+            .find(|&t| t > 0.0 && t < t_max && on_part(t))
             .map(ShapeHit::at)
+    }
+
+    /// Every crossing of the surface with `0 < t < t_max` (at most two).
+    #[inline]
+    pub fn crossings(&self, ray: &Ray, t_max: f64) -> Crossings {
+        let mut out = Crossings::default();
+        if let Some(((t0, t1), on_part)) = self.roots(ray) {
+            for t in [t0, t1] {
+                // A double root (tangent ray) touches the surface once.
+                if t > 0.0 && t < t_max && on_part(t) && out.as_slice().last() != Some(&t) {
+                    out.push(t);
+                }
+            }
+        }
+        out
     }
 
     pub fn surface(&self, ray: &Ray, hit: &ShapeHit) -> Surface {

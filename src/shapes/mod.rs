@@ -74,6 +74,31 @@ impl ShapeHit {
     }
 }
 
+/// The parameters at which a ray crosses a shape's surface, nearest first:
+/// at most two for the shapes glint has (a sphere, a quadric or a cone is
+/// entered and left; a triangle or a plane is crossed once).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Crossings {
+    t: [f64; 2],
+    len: u8,
+}
+
+impl Crossings {
+    /// Appends `t`, which must not be nearer than the last one.
+    #[inline]
+    pub(crate) fn push(&mut self, t: f64) {
+        if (self.len as usize) < self.t.len() {
+            self.t[self.len as usize] = t;
+            self.len += 1;
+        }
+    }
+
+    #[inline]
+    pub fn as_slice(&self) -> &[f64] {
+        &self.t[..self.len as usize]
+    }
+}
+
 /// Where a ray met a surface.
 #[derive(Clone, Copy, Debug)]
 pub struct Surface {
@@ -109,6 +134,25 @@ impl Shape {
         }
     }
 
+    /// Every crossing of the surface with `0 < t < t_max`, nearest first:
+    /// what a shadow ray needs to attenuate light once per surface crossed.
+    #[inline]
+    pub fn crossings(&self, ray: &PreparedRay, t_max: f64) -> Crossings {
+        match self {
+            Shape::Sphere(s) => s.crossings(&ray.ray, t_max),
+            Shape::Quadric(q) => q.crossings(&ray.ray, t_max),
+            Shape::Cone(c) => c.crossings(&ray.ray, t_max),
+            // Flat shapes are crossed at most once: the nearest hit is all.
+            _ => {
+                let mut out = Crossings::default();
+                if let Some(hit) = self.intersect(ray, t_max) {
+                    out.push(hit.t);
+                }
+                out
+            }
+        }
+    }
+
     /// The surface point of a hit found by [`Shape::intersect`] with `ray`.
     pub fn surface(&self, ray: &Ray, hit: &ShapeHit, vertex_normals: &[[DVec3; 3]]) -> Surface {
         match self {
@@ -131,8 +175,9 @@ impl Shape {
         }
     }
 
-    /// Whether the shape may touch the closed box `b`: exact for triangles
-    /// and spheres, by bounding box otherwise. Never false when it does touch.
+    /// Whether the shape's surface may touch the closed box `b`: exact for
+    /// triangles and spheres (a box inside a sphere does not touch its
+    /// surface), by bounding box otherwise. Never false when it does touch.
     pub fn overlaps_box(&self, b: &Aabb) -> bool {
         match self {
             Shape::Sphere(s) => s.overlaps_box(b),

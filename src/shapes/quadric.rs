@@ -1,4 +1,4 @@
-use super::{ShapeHit, Surface};
+use super::{Crossings, ShapeHit, Surface};
 use crate::math::{Aabb, DVec3, Ray, solve_quadratic_half};
 
 /// General quadric surface
@@ -84,12 +84,14 @@ impl Quadric {
         d.x * (a * d.x + b * d.y + c * d.z) + d.y * (e * d.y + f * d.z) + h * d.z * d.z
     }
 
+    /// The parameters where the ray's line meets the surface, smaller first,
+    /// and the parameter range inside the clip box (`None` if the ray misses
+    /// the box before `t_max`).
     #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<ShapeHit> {
-        let mut t_lo = 0.0;
-        let mut t_hi = t_max;
+    fn roots(&self, ray: &Ray, t_max: f64) -> Option<((f64, f64), (f64, f64))> {
+        let mut range = (0.0, t_max);
         if let Some(clip) = &self.clip {
-            (t_lo, t_hi) = clip.ray_range(ray, 0.0, t_max)?;
+            range = clip.ray_range(ray, 0.0, t_max)?;
         }
         let aq = self.quadratic_form(ray.dir);
         let half_bq = 0.5 * self.gradient(ray.origin).dot(ray.dir);
@@ -97,13 +99,35 @@ impl Quadric {
         // `Aq == 0` (a line parallel to a paraboloid's axis, a plane) is the
         // linear case, handled inside the solver; tiny `Aq` is handled by the
         // stable `c / q` root.
-        let (t0, t1) = solve_quadratic_half(aq, half_bq, cq)?;
+        Some((solve_quadratic_half(aq, half_bq, cq)?, range))
+    }
+
+    fn accepts(&self, ray: &Ray, t: f64, t_max: f64, (t_lo, t_hi): (f64, f64)) -> bool {
+        t > 0.0 && t < t_max && t >= t_lo && t <= t_hi && self.inside_clip(ray.at(t))
+    }
+
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<ShapeHit> {
+        let ((t0, t1), range) = self.roots(ray, t_max)?;
         [t0, t1]
             .into_iter()
-            .find(|&t| {
-                t > 0.0 && t < t_max && t >= t_lo && t <= t_hi && self.inside_clip(ray.at(t))
-            })
+            .find(|&t| self.accepts(ray, t, t_max, range))
             .map(ShapeHit::at)
+    }
+
+    /// Every crossing of the surface with `0 < t < t_max` (at most two).
+    #[inline]
+    pub fn crossings(&self, ray: &Ray, t_max: f64) -> Crossings {
+        let mut out = Crossings::default();
+        if let Some(((t0, t1), range)) = self.roots(ray, t_max) {
+            for t in [t0, t1] {
+                // A double root (tangent ray, the linear case) counts once.
+                if self.accepts(ray, t, t_max, range) && out.as_slice().last() != Some(&t) {
+                    out.push(t);
+                }
+            }
+        }
+        out
     }
 
     fn inside_clip(&self, p: DVec3) -> bool {

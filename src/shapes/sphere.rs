@@ -1,4 +1,4 @@
-use super::ShapeHit;
+use super::{Crossings, ShapeHit};
 use crate::math::{Aabb, DVec3, Ray};
 
 #[derive(Clone, Debug, PartialEq)]
@@ -12,12 +12,13 @@ impl Sphere {
         Self { center, radius }
     }
 
-    /// Ray/sphere intersection in the form of Haines et al., "Precision
-    /// Improvements for Ray/Sphere Intersection" (Ray Tracing Gems ch. 7):
-    /// the discriminant is `r^2 - |f - (f.d) d|^2`, which stays accurate for a
-    /// small sphere far away, and the roots use the stable `c / q`, `q` pair.
+    /// Both parameters where the ray's line meets the sphere, smaller first,
+    /// in the form of Haines et al., "Precision Improvements for Ray/Sphere
+    /// Intersection" (Ray Tracing Gems ch. 7): the discriminant is
+    /// `r^2 - |f - (f.d) d|^2`, which stays accurate for a small sphere far
+    /// away, and the roots use the stable `c / q`, `q` pair.
     #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<ShapeHit> {
+    fn roots(&self, ray: &Ray) -> Option<(f64, f64)> {
         let f = ray.origin - self.center;
         let b = f.dot(ray.dir);
         let perp = f - b * ray.dir;
@@ -29,7 +30,13 @@ impl Sphere {
         let c = f.length_squared() - r2;
         let q = -(b + disc.sqrt().copysign(b));
         let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (c / q, q) };
-        let (near, far) = if t0 <= t1 { (t0, t1) } else { (t1, t0) };
+        Some(if t0 <= t1 { (t0, t1) } else { (t1, t0) })
+    }
+
+    /// The nearest hit with `0 < t < t_max`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<ShapeHit> {
+        let (near, far) = self.roots(ray)?;
         if near > 0.0 && near < t_max {
             Some(ShapeHit::at(near))
         } else if far > 0.0 && far < t_max {
@@ -37,6 +44,21 @@ impl Sphere {
         } else {
             None
         }
+    }
+
+    /// Every crossing of the surface with `0 < t < t_max` (at most two).
+    #[inline]
+    pub fn crossings(&self, ray: &Ray, t_max: f64) -> Crossings {
+        let mut out = Crossings::default();
+        if let Some((near, far)) = self.roots(ray) {
+            for t in [near, far] {
+                // A tangent ray's double root touches the surface once.
+                if t > 0.0 && t < t_max && out.as_slice().last() != Some(&t) {
+                    out.push(t);
+                }
+            }
+        }
+        out
     }
 
     pub fn surface(&self, ray: &Ray, hit: &ShapeHit) -> super::Surface {
@@ -58,9 +80,15 @@ impl Sphere {
         Aabb::new(self.center - r, self.center + r)
     }
 
+    /// Whether the sphere's surface (not the ball inside it) touches the
+    /// closed box: the box's nearest point lies within the radius and its
+    /// farthest corner beyond it. A cell deep inside a large sphere holds
+    /// none of its surface and never references it.
     pub fn overlaps_box(&self, b: &Aabb) -> bool {
+        let r2 = self.radius * self.radius;
         let nearest = self.center.clamp(b.min, b.max);
-        nearest.distance_squared(self.center) <= self.radius * self.radius
+        let farthest = (self.center - b.min).abs().max((b.max - self.center).abs());
+        nearest.distance_squared(self.center) <= r2 && farthest.length_squared() >= r2
     }
 }
 
@@ -98,6 +126,18 @@ mod tests {
             s.intersect(&ray([0.0, 0.0, 5.0], [0.0, 0.0, -1.0]), 3.9)
                 .is_none()
         );
+    }
+
+    #[test]
+    fn crossings_are_both_roots_in_range() {
+        let s = Sphere::new(DVec3::ZERO, 1.0);
+        let r = ray([0.0, 0.0, 5.0], [0.0, 0.0, -1.0]);
+        assert_eq!(s.crossings(&r, f64::INFINITY).as_slice(), &[4.0, 6.0]);
+        assert_eq!(s.crossings(&r, 5.0).as_slice(), &[4.0]);
+        let inside = ray([0.0, 0.0, 0.5], [0.0, 0.0, -1.0]);
+        assert_eq!(s.crossings(&inside, f64::INFINITY).as_slice(), &[1.5]);
+        let away = ray([0.0, 0.0, 5.0], [0.0, 0.0, 1.0]);
+        assert!(s.crossings(&away, f64::INFINITY).as_slice().is_empty());
     }
 
     #[test]
@@ -141,5 +181,11 @@ mod tests {
             !s.overlaps_box(&past_corner),
             "bounding boxes overlap, the sphere does not"
         );
+        let deep_inside = Aabb::new(DVec3::splat(-0.5), DVec3::splat(0.5));
+        assert!(!s.overlaps_box(&deep_inside), "no surface inside the box");
+        let holds_the_sphere = Aabb::new(DVec3::splat(-2.0), DVec3::splat(2.0));
+        assert!(s.overlaps_box(&holds_the_sphere));
+        let touching_inside = Aabb::new(DVec3::ZERO, DVec3::new(1.0, 0.1, 0.1));
+        assert!(s.overlaps_box(&touching_inside));
     }
 }

@@ -154,7 +154,7 @@ impl GlintApp {
         if let Some((w, h)) = options.size {
             (settings.width, settings.height) = (w, h);
         }
-        let (octree, build_seconds) = build_octree(&scene);
+        let (octree, build_seconds) = build_octree(&scene)?;
         let mut anti_aliasing = anti_aliasing;
         match options.compare {
             Some(CompareSetting::Octree) => settings.use_octree = !settings.use_octree,
@@ -386,11 +386,12 @@ impl GlintApp {
     /// Re-reads the scene file, keeping the camera; a failure keeps the
     /// current scene on screen.
     pub fn reload(&mut self) {
-        match self.source.load() {
-            Ok(scene) => {
-                self.install_scene(scene, false);
-                self.say(format!("reloaded {}", self.scene.name), false);
-            }
+        match self
+            .source
+            .load()
+            .and_then(|scene| self.install_scene(scene, false))
+        {
+            Ok(()) => self.say(format!("reloaded {}", self.scene.name), false),
             Err(e) => self.say(
                 format!("reload failed, keeping the previous scene: {e:#}"),
                 true,
@@ -401,18 +402,20 @@ impl GlintApp {
     /// Opens another scene file.
     pub fn open(&mut self, path: PathBuf) {
         let source = SceneSource::File(path);
-        match source.load() {
-            Ok(scene) => {
+        match source
+            .load()
+            .and_then(|scene| self.install_scene(scene, true))
+        {
+            Ok(()) => {
                 self.source = source;
-                self.install_scene(scene, true);
                 self.say(format!("opened {}", self.scene.name), false);
             }
             Err(e) => self.say(format!("cannot open: {e:#}"), true),
         }
     }
 
-    fn install_scene(&mut self, scene: Scene, take_camera: bool) {
-        let (octree, seconds) = build_octree(&scene);
+    fn install_scene(&mut self, scene: Scene, take_camera: bool) -> anyhow::Result<()> {
+        let (octree, seconds) = build_octree(&scene)?;
         if take_camera {
             self.camera = scene.camera;
             let keep_view = self.settings.view;
@@ -426,6 +429,7 @@ impl GlintApp {
         self.build_seconds = seconds;
         self.scene = Arc::new(scene);
         self.scene_version += 1;
+        Ok(())
     }
 
     fn open_dialog(&mut self) {
@@ -706,10 +710,11 @@ impl eframe::App for GlintApp {
     }
 }
 
-fn build_octree(scene: &Scene) -> (Octree, f64) {
+fn build_octree(scene: &Scene) -> anyhow::Result<(Octree, f64)> {
     let start = Instant::now();
-    let octree = Octree::build(&scene.shapes, scene.octree_params);
-    (octree, start.elapsed().as_secs_f64())
+    let octree = Octree::build(&scene.shapes, scene.octree_params)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", scene.name))?;
+    Ok((octree, start.elapsed().as_secs_f64()))
 }
 
 /// rfd's dialogs go through the XDG desktop portal on D-Bus; without a

@@ -159,25 +159,25 @@ pub fn controls_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                         egui::Grid::new(("material-grid", i))
                             .num_columns(2)
                             .show(ui, |ui| {
-                                for (label, value, max) in [
-                                    ("kd", &mut m.kd, 1.0),
-                                    ("ks", &mut m.ks, 1.0),
-                                    ("shininess", &mut m.shininess, 10_000.0),
-                                    ("reflectivity", &mut m.reflectivity, 1.0),
-                                    ("transparency", &mut m.transparency, 1.0),
-                                    ("ior", &mut m.ior, 4.0),
+                                // The ranges scene files are held to.
+                                use crate::material::{IOR_RANGE, SHININESS_RANGE, UNIT_RANGE};
+                                for (label, value, range, step) in [
+                                    ("kd", &mut m.kd, UNIT_RANGE, 0.005),
+                                    ("ks", &mut m.ks, UNIT_RANGE, 0.005),
+                                    ("shininess", &mut m.shininess, SHININESS_RANGE, 1.0),
+                                    ("reflectivity", &mut m.reflectivity, UNIT_RANGE, 0.005),
+                                    ("transparency", &mut m.transparency, UNIT_RANGE, 0.005),
+                                    ("ior", &mut m.ior, IOR_RANGE, 0.005),
                                 ] {
                                     ui.label(label);
-                                    let step = if max > 10.0 { 1.0 } else { 0.005 };
                                     changed |= ui
-                                        .add(DragValue::new(value).range(0.0..=max).speed(step))
+                                        .add(DragValue::new(value).range(range).speed(step))
                                         .changed();
                                     ui.end_row();
                                 }
                             });
                     });
                 if changed {
-                    m.ior = m.ior.max(0.01);
                     app.scene_mut().materials[i] = m;
                 }
             }

@@ -53,6 +53,12 @@ pub struct BenchArgs {
     /// Leaf sizes for `--sweep`.
     #[arg(long, value_delimiter = ',', default_value = "2,4,8,16")]
     pub sweep_leaf_sizes: Vec<u32>,
+    /// Maximum duplication factors for `--sweep` (default: the scene's).
+    #[arg(long, value_delimiter = ',')]
+    pub sweep_max_duplications: Vec<u32>,
+    /// Cost-driven settings for `--sweep`.
+    #[arg(long, value_delimiter = ',', value_enum, default_value = "on,off")]
+    pub sweep_cost_driven: Vec<crate::common::Switch>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -142,7 +148,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             let (tree, s) =
                 timed(|| pool.install(|| Octree::build(&scene.shapes, scene.octree_params)));
             build_times.push(s);
-            octree = Some(tree);
+            octree = Some(tree?);
         }
         let Some(octree) = octree else {
             bail!("no repeats")
@@ -311,58 +317,70 @@ fn sweep(args: &BenchArgs) -> Result<()> {
     let mut rows = Vec::new();
     if args.format == Format::Markdown {
         println!(
-            "| scene | cost-driven | max depth | leaf size | build (s) | render (s) | N_IT | N_TS | N_ETS | nodes | memory (KiB) |"
+            "| scene | cost-driven | max depth | leaf size | max duplication | build (s) | render (s) | N_IT | N_TS | N_ETS | nodes | memory (KiB) |"
         );
-        println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+        println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     }
     for path in &args.scenes {
         let (mut scene, _) = load_scene(path)?;
         let mut settings = bench_settings(args, &mut scene);
         settings.use_octree = true;
         eprintln!("sweep {}", path.display());
-        for &cost_driven in &[true, false] {
-            for &max_depth in &args.sweep_depths {
-                for &leaf_size in &args.sweep_leaf_sizes {
-                    let params = glint::accel::OctreeParams {
-                        max_depth: max_depth.min(glint::accel::MAX_OCTREE_DEPTH),
-                        leaf_size: leaf_size.max(1),
-                        cost_driven,
-                    };
-                    let (mut builds, mut renders) = (Vec::new(), Vec::new());
-                    let mut tree = None;
-                    for _ in 0..args.repeat {
-                        let (t, s) =
-                            timed(|| pool.install(|| Octree::build(&scene.shapes, params)));
-                        builds.push(s);
-                        tree = Some(t);
+        let duplications = if args.sweep_max_duplications.is_empty() {
+            vec![scene.octree_params.max_duplication]
+        } else {
+            args.sweep_max_duplications.clone()
+        };
+        let mut combinations = Vec::new();
+        for c in &args.sweep_cost_driven {
+            for &d in &args.sweep_depths {
+                for &l in &args.sweep_leaf_sizes {
+                    for &x in &duplications {
+                        combinations.push((c.is_on(), d, l, x));
                     }
-                    let Some(octree) = tree else {
-                        bail!("no repeats")
-                    };
-                    let renderer = Renderer::new(&scene, &octree, settings)?;
-                    let counts = pool.install(|| renderer.render(true, None).1);
-                    for _ in 0..args.repeat {
-                        renders.push(timed(|| pool.install(|| renderer.render(false, None))).1);
-                    }
-                    let render_s = median(renders);
-                    let total = counts.rays.total().max(1) as f64;
-                    let row = SweepRow {
-                        scene: path.display().to_string(),
-                        octree_params: params,
-                        build_s: median(builds),
-                        render_s,
-                        mrays_per_s: total / render_s.max(1e-12) / 1e6,
-                        intersection_tests_per_ray: counts.work.intersection_tests as f64 / total,
-                        traversal_steps_per_ray: counts.work.traversal_steps as f64 / total,
-                        leaves_visited_per_ray: counts.work.leaves_visited as f64 / total,
-                        octree_stats: octree.stats(),
-                    };
-                    if args.format == Format::Markdown {
-                        print_sweep_row(&row);
-                    }
-                    rows.push(row);
                 }
             }
+        }
+        for (cost_driven, max_depth, leaf_size, max_duplication) in combinations {
+            let params = glint::accel::OctreeParams {
+                max_depth: max_depth.min(glint::accel::MAX_OCTREE_DEPTH),
+                leaf_size: leaf_size.max(1),
+                cost_driven,
+                max_duplication: max_duplication.clamp(1, 8),
+                ..scene.octree_params
+            };
+            let (mut builds, mut renders) = (Vec::new(), Vec::new());
+            let mut tree = None;
+            for _ in 0..args.repeat {
+                let (t, s) = timed(|| pool.install(|| Octree::build(&scene.shapes, params)));
+                builds.push(s);
+                tree = Some(t?);
+            }
+            let Some(octree) = tree else {
+                bail!("no repeats")
+            };
+            let renderer = Renderer::new(&scene, &octree, settings)?;
+            let counts = pool.install(|| renderer.render(true, None).1);
+            for _ in 0..args.repeat {
+                renders.push(timed(|| pool.install(|| renderer.render(false, None))).1);
+            }
+            let render_s = median(renders);
+            let total = counts.rays.total().max(1) as f64;
+            let row = SweepRow {
+                scene: path.display().to_string(),
+                octree_params: params,
+                build_s: median(builds),
+                render_s,
+                mrays_per_s: total / render_s.max(1e-12) / 1e6,
+                intersection_tests_per_ray: counts.work.intersection_tests as f64 / total,
+                traversal_steps_per_ray: counts.work.traversal_steps as f64 / total,
+                leaves_visited_per_ray: counts.work.leaves_visited as f64 / total,
+                octree_stats: octree.stats(),
+            };
+            if args.format == Format::Markdown {
+                print_sweep_row(&row);
+            }
+            rows.push(row);
         }
     }
     if args.format == Format::Json {
@@ -376,7 +394,7 @@ fn print_sweep_row(r: &SweepRow) {
         .file_name()
         .map_or(r.scene.clone(), |n| n.to_string_lossy().into_owned());
     println!(
-        "| {} | {} | {} | {} | {:.3} | {:.3} | {:.2} | {:.2} | {:.2} | {} | {:.0} |",
+        "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.2} | {:.2} | {:.2} | {} | {:.0} |",
         name,
         if r.octree_params.cost_driven {
             "on"
@@ -385,6 +403,7 @@ fn print_sweep_row(r: &SweepRow) {
         },
         r.octree_params.max_depth,
         r.octree_params.leaf_size,
+        r.octree_params.max_duplication,
         r.build_s,
         r.render_s,
         r.intersection_tests_per_ray,

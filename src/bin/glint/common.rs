@@ -82,6 +82,15 @@ pub struct OctreeArgs {
     /// Let the surface-area cost estimate stop subdivision early.
     #[arg(long, value_enum)]
     pub octree_cost_driven: Option<Switch>,
+    /// Keep a node a leaf when its children would hold more than this many
+    /// times its references (1 to 8; 8 never stops a split).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=8))]
+    pub octree_max_duplication: Option<u32>,
+    /// Memory budget of the octree in MiB (nodes and references, counted
+    /// while it is built); past it, nodes stay leaves, which is correct but
+    /// slower. Default 256.
+    #[arg(long, value_name = "MIB", value_parser = clap::value_parser!(u32).range(1..=glint::accel::MAX_MEMORY_BUDGET_MIB as i64))]
+    pub octree_memory_budget: Option<u32>,
 }
 
 impl OctreeArgs {
@@ -94,6 +103,12 @@ impl OctreeArgs {
         }
         if let Some(c) = self.octree_cost_driven {
             params.cost_driven = c.is_on();
+        }
+        if let Some(d) = self.octree_max_duplication {
+            params.max_duplication = d;
+        }
+        if let Some(m) = self.octree_memory_budget {
+            params.memory_budget_mib = m;
         }
     }
 }

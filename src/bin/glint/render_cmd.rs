@@ -119,6 +119,8 @@ struct RenderStats {
     leaves_visited_per_ray: f64,
     nonfinite_samples: u64,
     dropped_degenerate_triangles: usize,
+    /// Polygons dropped at load: of zero area, or not simple.
+    dropped_polygons: glint::scene::DroppedPolygons,
     #[serde(skip_serializing_if = "Option::is_none")]
     octree_stats: Option<OctreeStats>,
     /// With `--view cost` or `cost-steps`: the per-pixel count's range.
@@ -197,8 +199,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let build_start = Instant::now();
     let octree = if settings.use_octree || overlay_depth.is_some() {
         pool.install(|| Octree::build(&scene.shapes, scene.octree_params))
+            .with_context(|| format!("cannot build the octree of {scene_name}"))?
     } else {
-        Octree::build(&[], scene.octree_params)
+        Octree::build(&[], scene.octree_params)?
     };
     let build_s = build_start.elapsed().as_secs_f64();
 
@@ -261,6 +264,23 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             scene.dropped_triangles
         );
     }
+    let dropped = scene.dropped_polygons;
+    if dropped.total() > 0 {
+        eprintln!(
+            "note: {} polygons were skipped ({} with crossing edges, {} with no area)",
+            dropped.total(),
+            dropped.not_simple,
+            dropped.zero_area
+        );
+    }
+    if octree.stats().leaves_stopped_by_budget > 0 {
+        eprintln!(
+            "note: the octree reached its memory budget ({} MiB): {} nodes stayed leaves; \
+             --octree-memory-budget raises it",
+            scene.octree_params.memory_budget_mib,
+            octree.stats().leaves_stopped_by_budget
+        );
+    }
     if args.stats {
         let total = counts.rays.total();
         let per_ray = |x: u64| {
@@ -293,6 +313,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             leaves_visited_per_ray: per_ray(counts.work.leaves_visited),
             nonfinite_samples: counts.nonfinite_samples,
             dropped_degenerate_triangles: scene.dropped_triangles,
+            dropped_polygons: scene.dropped_polygons,
             octree_stats: settings.use_octree.then(|| octree.stats()),
             cost_per_pixel: frame.cost_summary().map(|c| CostJson {
                 min: c.min,

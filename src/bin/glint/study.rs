@@ -132,7 +132,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
         (base.width, base.height) = (w, h);
         base.use_octree = true;
         let study = Study {
-            octree: Octree::build(&scene.shapes, scene.octree_params),
+            octree: Octree::build(&scene.shapes, scene.octree_params)?,
             scene: &scene,
             repeat: args.repeat,
             pool: thread_pool(args.threads)?,
@@ -248,10 +248,12 @@ pub fn run(args: &StudyArgs) -> Result<()> {
                 let params = OctreeParams {
                     max_depth,
                     leaf_size,
-                    cost_driven: false,
+                    ..scene.octree_params
                 };
                 let start = Instant::now();
-                let tree = study.pool.install(|| Octree::build(&scene.shapes, params));
+                let tree = study
+                    .pool
+                    .install(|| Octree::build(&scene.shapes, params))?;
                 let build = start.elapsed().as_secs_f64();
                 let (t, _) = study.run(RenderSettings { samples: 1, ..base }, Some(&tree))?;
                 let renderer = Renderer::new(&scene, &tree, RenderSettings { samples: 1, ..base })?;
