@@ -15,6 +15,7 @@
 
 pub mod accel;
 pub mod camera;
+pub mod color;
 pub mod export;
 pub mod legend;
 pub mod material;
@@ -23,6 +24,7 @@ pub mod overlay;
 pub mod ray_tree;
 pub mod render;
 pub mod scene;
+pub mod settings;
 pub mod sha256;
 pub mod shapes;
 pub mod stats;

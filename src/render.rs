@@ -4,109 +4,20 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use rayon::prelude::*;
 
-use crate::accel::{ClosestHit, Octree, closest_brute_force, occlusion_brute_force};
+use crate::accel::{ClosestHit, Octree, Primitives, closest_brute_force, occlusion_brute_force};
 use crate::camera::{Camera, CameraError, CameraSpec, sample_offsets};
+pub use crate::color::linear_to_srgb;
+use crate::color::{ColorConvention, to_byte};
+use crate::material::Material;
 use crate::math::{Color, DVec3, Ray, offset_ray_origin, reflect, refract};
 use crate::ray_tree::{HitRecord, NoRecord, RayKind, RayNode, RayRecorder, ShadowRecord};
 use crate::scene::Scene;
+pub use crate::settings::{Protocol, RenderSettings, Sides, ViewMode};
 use crate::shapes::PreparedRay;
 use crate::stats::{Counter, NoCounts, RayCounts, WorkCounts};
 
-/// What the image shows.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum ViewMode {
-    /// Whitted shading (sRGB encoded on output).
-    #[default]
-    Shaded,
-    /// Geometric normal facing the camera as `(n + 1) / 2`, not sRGB encoded.
-    Normals,
-    /// Distance along the eye ray as `nearest / distance`: the nearest
-    /// visible point white, falling off towards black at the horizon.
-    Depth,
-    /// Intersection tests summed over every ray a pixel spawned (eye,
-    /// shadow, reflection, refraction), on the viridis colour map.
-    Cost,
-    /// Like [`ViewMode::Cost`], counting octree traversal steps.
-    CostSteps,
-    /// |1 sample − 16 samples| per pixel in sRGB, gain 4: where
-    /// anti-aliasing changes the picture. Built from two shaded renders.
-    AaNeed,
-}
-
-impl ViewMode {
-    pub const ALL: [ViewMode; 6] = [
-        ViewMode::Shaded,
-        ViewMode::Normals,
-        ViewMode::Depth,
-        ViewMode::Cost,
-        ViewMode::CostSteps,
-        ViewMode::AaNeed,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            ViewMode::Shaded => "shaded",
-            ViewMode::Normals => "normals",
-            ViewMode::Depth => "depth",
-            ViewMode::Cost => "cost",
-            ViewMode::CostSteps => "cost-steps",
-            ViewMode::AaNeed => "aa-need",
-        }
-    }
-
-    /// Whether pixels count the work of their rays.
-    pub fn is_cost(self) -> bool {
-        matches!(self, ViewMode::Cost | ViewMode::CostSteps)
-    }
-
-    /// Whether each eye ray is shaded (the full Whitted recursion runs).
-    fn traces_shading(self) -> bool {
-        matches!(
-            self,
-            ViewMode::Shaded | ViewMode::Cost | ViewMode::CostSteps | ViewMode::AaNeed
-        )
-    }
-}
-
-impl std::str::FromStr for ViewMode {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Self::ALL.into_iter().find(|v| v.name() == s).ok_or_else(|| {
-            format!(
-                "unknown view `{s}` (expected shaded, normals, depth, cost, cost-steps or aa-need)"
-            )
-        })
-    }
-}
-
 /// Gain of the aa-need view: a difference of 1/4 shows at full brightness.
 pub const AA_NEED_GAIN: f64 = 4.0;
-
-/// Everything that decides the image besides the scene; the command line
-/// and the viewer override the scene's own values.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct RenderSettings {
-    pub width: u32,
-    pub height: u32,
-    pub samples: u32,
-    pub max_depth: u32,
-    pub use_octree: bool,
-    pub view: ViewMode,
-}
-
-impl RenderSettings {
-    pub fn from_scene(scene: &Scene) -> Self {
-        Self {
-            width: scene.image.width,
-            height: scene.image.height,
-            samples: scene.image.samples,
-            max_depth: scene.image.max_depth,
-            use_octree: scene.octree_enabled,
-            view: ViewMode::Shaded,
-        }
-    }
-}
 
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
@@ -131,6 +42,8 @@ pub struct Frame {
     pub width: u32,
     pub height: u32,
     pub view: ViewMode,
+    /// How shaded values are written (see [`ColorConvention`]).
+    pub colors: ColorConvention,
     pub pixels: Vec<DVec3>,
 }
 
@@ -193,6 +106,12 @@ pub struct Renderer<'a> {
     camera: Camera,
     offsets: Vec<(f64, f64)>,
     is_transparent: Vec<bool>,
+    /// Per shape: seen from outside only ([`Sides::One`]); empty otherwise.
+    one_sided: Vec<bool>,
+    /// The scene's materials and background as this render shades them
+    /// (decoded into linear light for a linear render of display values).
+    materials: Vec<Material>,
+    background: Color,
     /// Magnitude of the scene's surfaces and the eye: the floor of ray offsets.
     floor_scale: f64,
 }
@@ -227,10 +146,28 @@ impl<'a> Renderer<'a> {
             return Err(RenderError::TooLarge(settings.width, settings.height));
         }
         let camera = Camera::new(camera, settings.width, settings.height)?;
-        let is_transparent = scene
+        let is_transparent: Vec<bool> = scene
             .shape_materials
             .iter()
             .map(|&m| scene.materials[m as usize].transparency > 0.0)
+            .collect();
+        let one_sided = match settings.sides {
+            Sides::Two => Vec::new(),
+            Sides::One => scene
+                .shapes
+                .iter()
+                .zip(&is_transparent)
+                .map(|(shape, &transparent)| !transparent && !shape.has_vertex_normals())
+                .collect(),
+        };
+        let shade = |c| settings.colors.shading_color(scene.color_values, c);
+        let materials = scene
+            .materials
+            .iter()
+            .map(|m| Material {
+                color: shade(m.color),
+                ..m.clone()
+            })
             .collect();
         Ok(Self {
             scene,
@@ -239,6 +176,9 @@ impl<'a> Renderer<'a> {
             camera,
             offsets: sample_offsets(settings.samples),
             is_transparent,
+            one_sided,
+            materials,
+            background: shade(scene.image.background),
             floor_scale: scene
                 .geometry_bounds()
                 .grow(camera.eye)
@@ -255,12 +195,20 @@ impl<'a> Renderer<'a> {
         &self.camera
     }
 
+    fn primitives(&self) -> Primitives<'_> {
+        Primitives {
+            shapes: &self.scene.shapes,
+            one_sided: &self.one_sided,
+            transparent: &self.is_transparent,
+        }
+    }
+
     fn closest<C: Counter>(&self, ray: &PreparedRay, counter: &mut C) -> Option<ClosestHit> {
+        let prims = self.primitives();
         if self.settings.use_octree {
-            self.octree
-                .closest(&self.scene.shapes, ray, f64::INFINITY, counter)
+            self.octree.closest(&prims, ray, f64::INFINITY, counter)
         } else {
-            closest_brute_force(&self.scene.shapes, ray, f64::INFINITY, counter)
+            closest_brute_force(&prims, ray, f64::INFINITY, counter)
         }
     }
 
@@ -272,22 +220,11 @@ impl<'a> Renderer<'a> {
     /// through a mesh's shared edge, two glass bodies touching: no
     /// interface), and any opaque surface blocks the light.
     fn transmittance<C: Counter>(&self, ray: &PreparedRay, distance: f64, counter: &mut C) -> f64 {
+        let prims = self.primitives();
         let found = if self.settings.use_octree {
-            self.octree.occlusion(
-                &self.scene.shapes,
-                &self.is_transparent,
-                ray,
-                distance,
-                counter,
-            )
+            self.octree.occlusion(&prims, ray, distance, counter)
         } else {
-            occlusion_brute_force(
-                &self.scene.shapes,
-                &self.is_transparent,
-                ray,
-                distance,
-                counter,
-            )
+            occlusion_brute_force(&prims, ray, distance, counter)
         };
         if found.is_blocked() {
             return 0.0;
@@ -301,7 +238,7 @@ impl<'a> Renderer<'a> {
             let material = self.scene.shape_materials[shape as usize];
             let repeat = previous.is_some_and(|(pt, pm)| pm == material && t - pt <= same_place);
             if !repeat {
-                pass *= self.scene.materials[material as usize].transparency;
+                pass *= self.materials[material as usize].transparency;
             }
             previous = Some((t, material));
         }
@@ -319,7 +256,7 @@ impl<'a> Renderer<'a> {
     ) -> Color {
         let prepared = PreparedRay::new(*ray);
         let Some(hit) = self.closest(&prepared, counter) else {
-            let background = self.scene.image.background;
+            let background = self.background;
             rec.local(background);
             rec.finish(background);
             return background;
@@ -330,7 +267,7 @@ impl<'a> Renderer<'a> {
         let scene = self.scene;
         let shape = &scene.shapes[hit.shape as usize];
         let surface = shape.surface(ray, &hit.hit, &scene.vertex_normals);
-        let material = &scene.materials[scene.shape_materials[hit.shape as usize] as usize];
+        let material = &self.materials[scene.shape_materials[hit.shape as usize] as usize];
         let entering = ray.dir.dot(surface.geometric_normal) < 0.0;
         // Normals facing the incoming ray: glint's surfaces are two-sided.
         let facing = if entering {
@@ -375,8 +312,16 @@ impl<'a> Renderer<'a> {
             }
             let l = to_light / distance;
             let n_dot_l = n.dot(l);
-            // A surface facing away from the light gets neither light nor a shadow ray.
-            if n_dot_l <= 0.0 || facing.dot(l) <= 0.0 {
+            // A surface facing away from the light gets neither light nor a
+            // shadow ray. glint asks both normals: an interpolated normal can
+            // face the light where the surface itself does not. The SPD
+            // asks the shading normal alone (its published shadow counts on
+            // the smooth-shaded teapot match only that way).
+            let faces_away = match self.settings.protocol {
+                Protocol::Glint => n_dot_l <= 0.0 || facing.dot(l) <= 0.0,
+                Protocol::Spd => n_dot_l <= 0.0,
+            };
+            if faces_away {
                 rec.shadow(|| verdict("faces-away", 0.0, Color::ZERO));
                 continue;
             }
@@ -420,10 +365,19 @@ impl<'a> Renderer<'a> {
                         color += weight * seen;
                     }
                     // Total internal reflection: the transmitted share is reflected.
-                    None => reflect_weight += material.transparency,
+                    None => {
+                        rays.total_internal_reflections += 1;
+                        reflect_weight += material.transparency;
+                    }
                 }
             }
-            if reflect_weight > 0.0 {
+            // The SPD counts a reflection ray from every reflective or
+            // transmitting surface, even one whose weight is zero.
+            let spawn_reflection = match self.settings.protocol {
+                Protocol::Glint => reflect_weight > 0.0,
+                Protocol::Spd => material.reflectivity > 0.0 || material.transparency > 0.0,
+            };
+            if spawn_reflection {
                 rays.reflection += 1;
                 let mut dir = reflect(ray.dir, n);
                 // An interpolated normal can send the mirror ray below the
@@ -444,11 +398,18 @@ impl<'a> Renderer<'a> {
         color
     }
 
-    /// The tree of rays the centre ray of pixel `(i, j)` spawns, with what
-    /// each hit and contributed. Its root colour is the pixel's value at
-    /// 1 sample per pixel in the shaded view.
+    /// The tree of rays the centre ray of pixel `(i, j)` spawns (under the
+    /// SPD protocol, its top-left corner ray), with what each hit and
+    /// contributed. Its root colour is the pixel's value at 1 sample per
+    /// pixel in the shaded view.
     pub fn ray_tree(&self, i: u32, j: u32) -> RayNode {
-        let ray = self.camera.ray(i, j, 0.5, 0.5);
+        // The SPD protocol has no centre ray: its top-left corner ray.
+        let offset = if self.settings.corner_rays() {
+            0.0
+        } else {
+            0.5
+        };
+        let ray = self.camera.ray(i, j, offset, offset);
         let mut root = RayNode::new(RayKind::Eye, &ray, 1, 1.0);
         let mut rays = RayCounts::default();
         self.trace(&ray, 1, &mut NoCounts, &mut rays, &mut root);
@@ -477,7 +438,56 @@ impl<'a> Renderer<'a> {
         }
     }
 
-    /// Value of pixel `(i, j)`: the mean over its samples.
+    /// The view's value for one eye ray (shaded colour, normal, distance
+    /// or work), with its rays and work counted; non-finite values are
+    /// counted and shown black.
+    fn sample<C: Counter>(&self, ray: &Ray, counter: &mut C, counts: &mut TileCounts) -> DVec3 {
+        counts.rays.primary += 1;
+        let view = self.settings.view;
+        let value = if view.is_cost() {
+            // Count this ray's work on its own, then pass it on.
+            let mut work = WorkCounts::default();
+            self.trace(ray, 1, &mut work, &mut counts.rays, &mut NoRecord);
+            counter.add_work(&work);
+            DVec3::new(
+                work.intersection_tests as f64,
+                work.traversal_steps as f64,
+                work.leaves_visited as f64,
+            )
+        } else if view.traces_shading() {
+            self.trace(ray, 1, counter, &mut counts.rays, &mut NoRecord)
+        } else {
+            self.inspect(ray, counter, &mut counts.rays)
+        };
+        if value.is_finite() {
+            value
+        } else {
+            counts.nonfinite_samples += 1;
+            DVec3::ZERO
+        }
+    }
+
+    /// A pixel's value from its samples: their mean; for the depth view the
+    /// mean distance of those that hit and the share that hit; for the cost
+    /// views their sum (`cost_sum`) or mean.
+    fn combine(&self, samples: &[DVec3], cost_sum: bool) -> DVec3 {
+        let n = samples.len().max(1) as f64;
+        match self.settings.view {
+            ViewMode::Depth => {
+                let hits: f64 = samples.iter().map(|v| v.y).sum();
+                if hits > 0.0 {
+                    let distance: f64 = samples.iter().map(|v| v.x).sum();
+                    DVec3::new(distance / hits, hits / n, 0.0)
+                } else {
+                    DVec3::ZERO
+                }
+            }
+            ViewMode::Cost | ViewMode::CostSteps if cost_sum => samples.iter().sum(),
+            _ => samples.iter().sum::<DVec3>() / n,
+        }
+    }
+
+    /// Value of pixel `(i, j)` from its grid of samples.
     pub fn pixel<C: Counter>(
         &self,
         i: u32,
@@ -485,69 +495,140 @@ impl<'a> Renderer<'a> {
         counter: &mut C,
         counts: &mut TileCounts,
     ) -> DVec3 {
-        let mut sum = DVec3::ZERO;
-        let mut depth_hits = 0.0;
-        for &(dx, dy) in &self.offsets {
-            let ray = self.camera.ray(i, j, dx, dy);
-            counts.rays.primary += 1;
-            let view = self.settings.view;
-            let mut value = if view.is_cost() {
-                // Count this pixel's work on its own, then pass it on.
-                let mut work = WorkCounts::default();
-                self.trace(&ray, 1, &mut work, &mut counts.rays, &mut NoRecord);
-                counter.add_work(&work);
-                DVec3::new(
-                    work.intersection_tests as f64,
-                    work.traversal_steps as f64,
-                    work.leaves_visited as f64,
-                )
-            } else if view.traces_shading() {
-                self.trace(&ray, 1, counter, &mut counts.rays, &mut NoRecord)
-            } else {
-                self.inspect(&ray, counter, &mut counts.rays)
-            };
-            if !value.is_finite() {
-                counts.nonfinite_samples += 1;
-                value = DVec3::ZERO;
-            }
-            if self.settings.view == ViewMode::Depth {
-                depth_hits += value.y;
-                sum.x += value.x;
-            } else {
-                sum += value;
-            }
+        let mut samples = [DVec3::ZERO; 256];
+        let n = self.offsets.len();
+        for (k, &(dx, dy)) in self.offsets.iter().enumerate() {
+            samples[k] = self.sample(&self.camera.ray(i, j, dx, dy), counter, counts);
         }
-        let n = self.offsets.len() as f64;
-        match self.settings.view {
-            ViewMode::Depth if depth_hits > 0.0 => {
-                DVec3::new(sum.x / depth_hits, depth_hits / n, 0.0)
-            }
-            ViewMode::Depth => DVec3::ZERO,
-            ViewMode::Cost | ViewMode::CostSteps => sum,
-            _ => sum / n,
-        }
+        self.combine(&samples[..n], true)
     }
 
     /// Renders one tile into a row-major buffer of `tile.width * tile.height`.
     pub fn render_tile(&self, tile: Tile, count_work: bool) -> (Vec<DVec3>, TileCounts) {
-        let mut out = Vec::with_capacity((tile.width * tile.height) as usize);
         let mut counts = TileCounts::default();
-        if count_work {
+        let out = if count_work {
             let mut work = WorkCounts::default();
-            for j in tile.y..tile.y + tile.height {
-                for i in tile.x..tile.x + tile.width {
-                    out.push(self.pixel(i, j, &mut work, &mut counts));
-                }
-            }
+            let out = self.tile_pixels(tile, &mut work, &mut counts);
             counts.work = work;
+            out
         } else {
-            for j in tile.y..tile.y + tile.height {
-                for i in tile.x..tile.x + tile.width {
-                    out.push(self.pixel(i, j, &mut NoCounts, &mut counts));
-                }
+            self.tile_pixels(tile, &mut NoCounts, &mut counts)
+        };
+        (out, counts)
+    }
+
+    fn tile_pixels<C: Counter>(
+        &self,
+        tile: Tile,
+        counter: &mut C,
+        counts: &mut TileCounts,
+    ) -> Vec<DVec3> {
+        if self.settings.corner_rays() {
+            return self.tile_from_corners(tile, counter, counts);
+        }
+        let mut out = Vec::with_capacity((tile.width * tile.height) as usize);
+        for j in tile.y..tile.y + tile.height {
+            for i in tile.x..tile.x + tile.width {
+                out.push(self.pixel(i, j, counter, counts));
             }
         }
-        (out, counts)
+        out
+    }
+
+    /// The SPD's corner rays for a tile: its `(w + 1) x (h + 1)` corners,
+    /// each pixel the mean of its four. A corner on the tile's right or
+    /// bottom edge belongs to the next tile (unless it is the image's own
+    /// edge) and is traced again here without being counted, so the counts
+    /// of all tiles add up to exactly `(width + 1) x (height + 1)` eye rays.
+    fn tile_from_corners<C: Counter>(
+        &self,
+        tile: Tile,
+        counter: &mut C,
+        counts: &mut TileCounts,
+    ) -> Vec<DVec3> {
+        let (cw, ch) = (tile.width + 1, tile.height + 1);
+        let (w, h) = (self.settings.width, self.settings.height);
+        let mut corners = Vec::with_capacity((cw * ch) as usize);
+        for cj in tile.y..=tile.y + tile.height {
+            for ci in tile.x..=tile.x + tile.width {
+                let owned =
+                    (ci < tile.x + tile.width || ci == w) && (cj < tile.y + tile.height || cj == h);
+                let ray = self.camera.ray(ci, cj, 0.0, 0.0);
+                corners.push(if owned {
+                    self.sample(&ray, counter, counts)
+                } else {
+                    self.sample(&ray, &mut NoCounts, &mut TileCounts::default())
+                });
+            }
+        }
+        self.pixels_from_corners(&corners, cw, tile.width, tile.height)
+    }
+
+    /// Pixels of a `width x height` block from its row-major corner values
+    /// (`stride = width + 1` per row).
+    fn pixels_from_corners(
+        &self,
+        corners: &[DVec3],
+        stride: u32,
+        width: u32,
+        height: u32,
+    ) -> Vec<DVec3> {
+        let mut out = Vec::with_capacity((width * height) as usize);
+        for j in 0..height {
+            for i in 0..width {
+                let at = |di: u32, dj: u32| corners[((j + dj) * stride + i + di) as usize];
+                out.push(self.combine(&[at(0, 0), at(1, 0), at(0, 1), at(1, 1)], false));
+            }
+        }
+        out
+    }
+
+    /// Every corner ray of the image once (rows in parallel), then the
+    /// pixels from them: the SPD's `(width + 1) x (height + 1)` eye rays.
+    fn render_corners(
+        &self,
+        count_work: bool,
+        progress: Option<&(dyn Fn(u64, u64) + Sync)>,
+    ) -> (Frame, TileCounts) {
+        let (w, h) = (self.settings.width, self.settings.height);
+        let done = AtomicU64::new(0);
+        let rows: Vec<(Vec<DVec3>, TileCounts)> = (0..=h)
+            .into_par_iter()
+            .map(|cj| {
+                let mut counts = TileCounts::default();
+                let mut work = WorkCounts::default();
+                let row: Vec<DVec3> = (0..=w)
+                    .map(|ci| {
+                        let ray = self.camera.ray(ci, cj, 0.0, 0.0);
+                        if count_work {
+                            self.sample(&ray, &mut work, &mut counts)
+                        } else {
+                            self.sample(&ray, &mut NoCounts, &mut counts)
+                        }
+                    })
+                    .collect();
+                counts.work = work;
+                let n = done.fetch_add(1, Ordering::Relaxed) + 1;
+                if let Some(p) = progress {
+                    p(n, h as u64 + 1);
+                }
+                (row, counts)
+            })
+            .collect();
+        let mut counts = TileCounts::default();
+        let mut corners = Vec::with_capacity(((w + 1) * (h + 1)) as usize);
+        for (row, c) in rows {
+            counts += c;
+            corners.extend(row);
+        }
+        let frame = Frame {
+            width: w,
+            height: h,
+            view: self.settings.view,
+            colors: self.settings.colors,
+            pixels: self.pixels_from_corners(&corners, w + 1, w, h),
+        };
+        (frame, counts)
     }
 
     /// Traces every `every`-th row of the image (rows 0, every, 2 every, ...)
@@ -583,6 +664,9 @@ impl<'a> Renderer<'a> {
         count_work: bool,
         progress: Option<&(dyn Fn(u64, u64) + Sync)>,
     ) -> (Frame, TileCounts) {
+        if self.settings.corner_rays() {
+            return self.render_corners(count_work, progress);
+        }
         let (w, h) = (self.settings.width, self.settings.height);
         let all = tiles(w, h);
         let total = all.len() as u64;
@@ -598,19 +682,18 @@ impl<'a> Renderer<'a> {
                 r
             })
             .collect();
-        assemble_tiles(w, h, self.settings.view, &all, results)
+        assemble_tiles(&self.settings, &all, results)
     }
 }
 
 /// Puts rendered tiles together into a frame, summing their counts in tile
 /// order (so totals never depend on the thread schedule).
 pub fn assemble_tiles(
-    width: u32,
-    height: u32,
-    view: ViewMode,
+    settings: &RenderSettings,
     tiles: &[Tile],
     results: impl IntoIterator<Item = (Vec<DVec3>, TileCounts)>,
 ) -> (Frame, TileCounts) {
+    let (width, height) = (settings.width, settings.height);
     let mut pixels = vec![DVec3::ZERO; (width * height) as usize];
     let mut counts = TileCounts::default();
     for (tile, (values, c)) in tiles.iter().zip(results) {
@@ -625,7 +708,8 @@ pub fn assemble_tiles(
     let frame = Frame {
         width,
         height,
-        view,
+        view: settings.view,
+        colors: settings.colors,
         pixels,
     };
     (frame, counts)
@@ -722,41 +806,36 @@ fn format_count(v: f64) -> String {
     }
 }
 
-/// Root-mean-square error and PSNR of `a` against `reference`, in linear
-/// light and after sRGB encoding (both on [0, 1], channels clamped).
+/// Root-mean-square error and PSNR of an image against a reference, in
+/// shading values (linear light, or display values under
+/// [`ColorConvention::Display`]) and as displayed (after the convention's
+/// encoding: sRGB for linear frames), both on [0, 1] with channels clamped.
 #[derive(Clone, Copy, Debug)]
 pub struct ImageError {
-    pub rmse_linear: f64,
-    pub psnr_linear: f64,
-    pub rmse_srgb: f64,
-    pub psnr_srgb: f64,
-    /// Fraction of pixels differing by more than 1/255 in sRGB.
+    pub rmse_shaded: f64,
+    pub psnr_shaded: f64,
+    pub rmse_display: f64,
+    pub psnr_display: f64,
+    /// Fraction of pixels differing by more than 1/255 as displayed.
     pub visible_fraction: f64,
 }
 
-pub fn image_error(a: &[DVec3], reference: &[DVec3]) -> ImageError {
-    let (mut lin, mut srgb, mut visible) = (0.0, 0.0, 0usize);
+pub fn image_error(a: &[DVec3], reference: &[DVec3], colors: ColorConvention) -> ImageError {
+    let (mut shaded, mut display, mut visible) = (0.0, 0.0, 0usize);
     for (p, q) in a.iter().zip(reference) {
         let (p, q) = (
             p.clamp(DVec3::ZERO, DVec3::ONE),
             q.clamp(DVec3::ZERO, DVec3::ONE),
         );
-        lin += (p - q).length_squared();
-        let enc = |v: DVec3| {
-            DVec3::new(
-                linear_to_srgb(v.x),
-                linear_to_srgb(v.y),
-                linear_to_srgb(v.z),
-            )
-        };
-        let d = enc(p) - enc(q);
-        srgb += d.length_squared();
+        shaded += (p - q).length_squared();
+        let d = colors.encode_rgb(p) - colors.encode_rgb(q);
+        display += d.length_squared();
         if d.abs().max_element() > 1.0 / 255.0 {
             visible += 1;
         }
     }
     let n = (a.len() * 3).max(1) as f64;
-    let (rl, rs) = ((lin / n).sqrt(), (srgb / n).sqrt());
+    let (rs, rd) = ((shaded / n).sqrt(), (display / n).sqrt());
     let psnr = |r: f64| {
         if r > 0.0 {
             -20.0 * r.log10()
@@ -765,37 +844,24 @@ pub fn image_error(a: &[DVec3], reference: &[DVec3]) -> ImageError {
         }
     };
     ImageError {
-        rmse_linear: rl,
-        psnr_linear: psnr(rl),
-        rmse_srgb: rs,
-        psnr_srgb: psnr(rs),
+        rmse_shaded: rs,
+        psnr_shaded: psnr(rs),
+        rmse_display: rd,
+        psnr_display: psnr(rd),
         visible_fraction: visible as f64 / a.len().max(1) as f64,
     }
 }
 
-/// sRGB transfer function (IEC 61966-2-1) of a linear value in `[0, 1]`.
-pub fn linear_to_srgb(x: f64) -> f64 {
-    let x = x.clamp(0.0, 1.0);
-    if x <= 0.003_130_8 {
-        12.92 * x
-    } else {
-        1.055 * x.powf(1.0 / 2.4) - 0.055
-    }
-}
-
-fn to_byte(x: f64) -> u8 {
-    (x.clamp(0.0, 1.0) * 255.0).round() as u8
-}
-
 impl Frame {
-    /// 8-bit RGB, row-major from the top: sRGB-encoded for the shaded view,
-    /// raw for normals, normalised to the visible range for depth.
+    /// 8-bit RGB, row-major from the top: the shaded view encoded by its
+    /// colour convention (sRGB for linear light), normals raw, depth
+    /// normalised to the visible range.
     pub fn to_rgb8(&self) -> Vec<u8> {
         let mut out = Vec::with_capacity(self.pixels.len() * 3);
         match self.view {
             ViewMode::Shaded => {
                 for p in &self.pixels {
-                    out.extend([p.x, p.y, p.z].map(|c| to_byte(linear_to_srgb(c))));
+                    out.extend([p.x, p.y, p.z].map(|c| to_byte(self.colors.encode(c))));
                 }
             }
             ViewMode::Normals => {
@@ -847,19 +913,15 @@ impl Frame {
     }
 
     /// The 1-sample picture's difference from the 16-sample one, as the
-    /// [`ViewMode::AaNeed`] view: `|sRGB(one) − sRGB(sixteen)|` per channel.
+    /// [`ViewMode::AaNeed`] view: `|display(one) − display(sixteen)|` per
+    /// channel (sRGB-encoded values for linear frames).
     pub fn aa_need(one: &Frame, sixteen: &Frame) -> Frame {
-        let enc = |v: DVec3| {
-            DVec3::new(
-                linear_to_srgb(v.x),
-                linear_to_srgb(v.y),
-                linear_to_srgb(v.z),
-            )
-        };
+        let enc = |v: DVec3| sixteen.colors.encode_rgb(v);
         Frame {
             width: sixteen.width,
             height: sixteen.height,
             view: ViewMode::AaNeed,
+            colors: sixteen.colors,
             pixels: one
                 .pixels
                 .iter()

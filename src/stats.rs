@@ -65,6 +65,10 @@ pub struct RayCounts {
     pub shadow: u64,
     pub reflection: u64,
     pub refraction: u64,
+    /// Refractions that failed (total internal reflection): no refraction
+    /// ray was cast, the reflection ray took its weight. Not rays, so not
+    /// in [`RayCounts::total`].
+    pub total_internal_reflections: u64,
 }
 
 impl RayCounts {
@@ -80,5 +84,6 @@ impl std::ops::AddAssign for RayCounts {
         self.shadow += o.shadow;
         self.reflection += o.reflection;
         self.refraction += o.refraction;
+        self.total_internal_reflections += o.total_internal_reflections;
     }
 }

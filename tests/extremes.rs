@@ -150,12 +150,17 @@ fn closed_mesh_is_watertight_from_inside() {
     for target in &targets {
         let ray = PreparedRay::new(Ray::new(centre, (*target - centre).normalize()));
         let brute = glint::accel::closest_brute_force(
-            &shapes,
+            &glint::accel::Primitives::opaque(&shapes),
             &ray,
             f64::INFINITY,
             &mut glint::stats::NoCounts,
         );
-        let tree = octree.closest(&shapes, &ray, f64::INFINITY, &mut glint::stats::NoCounts);
+        let tree = octree.closest(
+            &glint::accel::Primitives::opaque(&shapes),
+            &ray,
+            f64::INFINITY,
+            &mut glint::stats::NoCounts,
+        );
         assert_eq!(brute, tree);
         if brute.is_none() {
             misses += 1;

@@ -250,7 +250,7 @@ fn aa_need_view_agrees_with_the_study_measure() {
             .0
     };
     let (one, sixteen) = (shaded(1), shaded(16));
-    let study = image_error(&one.pixels, &sixteen.pixels).visible_fraction;
+    let study = image_error(&one.pixels, &sixteen.pixels, sixteen.colors).visible_fraction;
     let view = need
         .pixels
         .iter()

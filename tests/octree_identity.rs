@@ -4,7 +4,7 @@
 mod common;
 
 use common::{all_scenes, load, render_with};
-use glint::accel::{Octree, OctreeParams, closest_brute_force, occlusion_brute_force};
+use glint::accel::{Octree, OctreeParams, Primitives, closest_brute_force, occlusion_brute_force};
 use glint::math::{DVec3, Ray};
 use glint::shapes::{PreparedRay, Shape, Sphere, Triangle};
 use glint::stats::NoCounts;
@@ -78,18 +78,22 @@ proptest! {
         max_depth in 0u32..7,
         leaf_size in 1u32..6,
         transparent_mask in any::<u64>(),
+        one_sided_mask in any::<u64>(),
         shadow_length in 0.5..20.0f64,
     ) {
         let params = OctreeParams { max_depth, leaf_size, cost_driven: max_depth % 2 == 0, ..Default::default() };
         let octree = Octree::build(&shapes, params).unwrap();
         let is_transparent: Vec<bool> = (0..shapes.len()).map(|i| transparent_mask >> (i % 64) & 1 == 1).collect();
+        // Some shapes one-sided (the SPD protocol's opaque surfaces).
+        let one_sided: Vec<bool> = (0..shapes.len()).map(|i| one_sided_mask >> (i % 64) & 1 == 1).collect();
+        let prims = Primitives { shapes: &shapes, one_sided: &one_sided, transparent: &is_transparent };
         for ray in rays {
             let prepared = PreparedRay::new(ray);
-            let brute = closest_brute_force(&shapes, &prepared, f64::INFINITY, &mut NoCounts);
-            let tree = octree.closest(&shapes, &prepared, f64::INFINITY, &mut NoCounts);
+            let brute = closest_brute_force(&prims, &prepared, f64::INFINITY, &mut NoCounts);
+            let tree = octree.closest(&prims, &prepared, f64::INFINITY, &mut NoCounts);
             prop_assert_eq!(brute, tree, "closest hit differs for {:?}", ray);
-            let b = occlusion_brute_force(&shapes, &is_transparent, &prepared, shadow_length, &mut NoCounts);
-            let t = octree.occlusion(&shapes, &is_transparent, &prepared, shadow_length, &mut NoCounts);
+            let b = occlusion_brute_force(&prims, &prepared, shadow_length, &mut NoCounts);
+            let t = octree.occlusion(&prims, &prepared, shadow_length, &mut NoCounts);
             prop_assert_eq!(b, t, "shadow verdict differs for {:?}", ray);
         }
     }
@@ -144,8 +148,9 @@ fn rays_in_split_planes_and_through_corners() {
                     ),
                 ] {
                     let ray = PreparedRay::new(Ray::new(origin, dir.normalize()));
-                    let brute = closest_brute_force(&shapes, &ray, f64::INFINITY, &mut NoCounts);
-                    let tree = octree.closest(&shapes, &ray, f64::INFINITY, &mut NoCounts);
+                    let prims = Primitives::opaque(&shapes);
+                    let brute = closest_brute_force(&prims, &ray, f64::INFINITY, &mut NoCounts);
+                    let tree = octree.closest(&prims, &ray, f64::INFINITY, &mut NoCounts);
                     assert_eq!(brute, tree, "origin {origin}, direction {dir}");
                     assert!(brute.is_some(), "these rays all hit a sphere");
                     checked += 1;

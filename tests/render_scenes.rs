@@ -84,6 +84,7 @@ fn head_on_plane_matches_the_analytic_colour() {
             max_depth: 1,
             background: DVec3::ZERO,
             ambient: DVec3::splat(0.2),
+            ..ImageSettings::default()
         },
     );
     scene.materials = vec![material.clone()];

@@ -383,3 +383,60 @@ fn viewer_exports_render_again_identically_from_their_metadata() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn protocol_spd_in_the_viewer_is_one_corner_pass_equal_to_the_cli() {
+    let source = SceneSource::File(common::repo_path("scenes/spd/sizes/balls_s1.nff"));
+    let mut app = GlintApp::new(source, ViewerOptions::default(), || {}).unwrap();
+    app.settings_mut().width = 48;
+    app.settings_mut().height = 40;
+    app.set_anti_aliasing(true);
+    let mut h = harness(app);
+    // NFF scenes shade display values by default; the panel says so.
+    assert_eq!(
+        h.state().settings().colors,
+        glint::color::ColorConvention::Display
+    );
+    let before = h.state().worker().generation();
+    h.get_by_label("spd").click();
+    h.run_steps(2);
+    let settings = *h.state().settings();
+    assert_eq!(settings.protocol, glint::render::Protocol::Spd);
+    assert_eq!(settings.max_depth, 5, "the protocol's depth");
+    assert_eq!(settings.sides, glint::render::Sides::One);
+    assert!(h.state().worker().generation() > before, "restarted");
+    settle(&mut h);
+    let generation = h.state().worker().generation();
+    let kinds: Vec<PassKind> = h
+        .state()
+        .worker()
+        .history()
+        .iter()
+        .filter(|r| r.generation == generation)
+        .map(|r| r.kind)
+        .collect();
+    assert_eq!(
+        kinds,
+        vec![PassKind::Corners],
+        "no 16-sample pass under the protocol"
+    );
+    let record = h.state().worker().history().last().copied().unwrap();
+    assert_eq!(record.rays.primary, 49 * 41, "every corner once");
+    let scene = common::load("scenes/spd/sizes/balls_s1.nff");
+    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let cli = Renderer::new(&scene, &octree, settings)
+        .unwrap()
+        .render(false, None)
+        .0
+        .to_rgb8();
+    let shown: Vec<u8> = h.state().worker().with_buffer(|b| {
+        b.rgba
+            .chunks_exact(4)
+            .flat_map(|p| [p[0], p[1], p[2]])
+            .collect()
+    });
+    assert!(
+        shown == cli,
+        "the corner pass equals `glint render --protocol spd`"
+    );
+}

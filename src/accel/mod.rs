@@ -12,6 +12,46 @@ pub use octree::{
 use crate::shapes::{PreparedRay, Shape, ShapeHit};
 use crate::stats::Counter;
 
+/// The shapes a ray query runs over, and what it must know of each.
+#[derive(Clone, Copy, Debug)]
+pub struct Primitives<'a> {
+    pub shapes: &'a [Shape],
+    /// Shapes seen only from outside (`true`); empty when every shape is
+    /// two-sided, glint's default.
+    pub one_sided: &'a [bool],
+    /// Shapes that let light through: shadow rays record their crossings
+    /// instead of stopping. Empty when none does.
+    pub transparent: &'a [bool],
+}
+
+impl<'a> Primitives<'a> {
+    /// Every shape two-sided and opaque.
+    pub fn opaque(shapes: &'a [Shape]) -> Self {
+        Self {
+            shapes,
+            one_sided: &[],
+            transparent: &[],
+        }
+    }
+
+    /// Shape `index`'s nearest hit in `(0, t_max)`, on its outside only if
+    /// it is one-sided.
+    #[inline(always)]
+    fn intersect(&self, index: u32, ray: &PreparedRay, t_max: f64) -> Option<ShapeHit> {
+        let shape = &self.shapes[index as usize];
+        if self.one_sided.get(index as usize) == Some(&true) {
+            shape.intersect_front(ray, t_max)
+        } else {
+            shape.intersect(ray, t_max)
+        }
+    }
+
+    #[inline(always)]
+    fn is_transparent(&self, index: u32) -> bool {
+        self.transparent.get(index as usize) == Some(&true)
+    }
+}
+
 /// The closest hit found so far.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ClosestHit {
@@ -23,7 +63,7 @@ pub struct ClosestHit {
 /// close with a lower index (so the answer never depends on visiting order).
 #[inline(always)]
 pub(crate) fn test_closest<C: Counter>(
-    shapes: &[Shape],
+    prims: &Primitives,
     index: u32,
     ray: &PreparedRay,
     best: &mut Option<ClosestHit>,
@@ -39,7 +79,7 @@ pub(crate) fn test_closest<C: Counter>(
     } else {
         limit
     };
-    if let Some(hit) = shapes[index as usize].intersect(ray, probe) {
+    if let Some(hit) = prims.intersect(index, ray, probe) {
         let better = match best {
             None => true,
             Some(b) => hit.t < b.hit.t || (hit.t == b.hit.t && index < b.shape),
@@ -62,14 +102,14 @@ fn next_up(x: f64) -> f64 {
 
 /// Closest hit by testing every shape in index order.
 pub fn closest_brute_force<C: Counter>(
-    shapes: &[Shape],
+    prims: &Primitives,
     ray: &PreparedRay,
     t_max: f64,
     counter: &mut C,
 ) -> Option<ClosestHit> {
     let mut best = None;
-    for i in 0..shapes.len() as u32 {
-        test_closest(shapes, i, ray, &mut best, t_max, counter);
+    for i in 0..prims.shapes.len() as u32 {
+        test_closest(prims, i, ray, &mut best, t_max, counter);
     }
     best
 }
@@ -158,8 +198,7 @@ impl ShadowCrossings {
 /// what it crosses; `true` once an opaque surface blocks the ray.
 #[inline(always)]
 pub(crate) fn test_occlusion<C: Counter>(
-    shapes: &[Shape],
-    is_transparent: &[bool],
+    prims: &Primitives,
     index: u32,
     ray: &PreparedRay,
     t_max: f64,
@@ -167,14 +206,17 @@ pub(crate) fn test_occlusion<C: Counter>(
     counter: &mut C,
 ) -> bool {
     counter.intersection_test();
-    let shape = &shapes[index as usize];
-    if !is_transparent[index as usize] {
-        if shape.intersect(ray, t_max).is_some() {
+    if !prims.is_transparent(index) {
+        if prims.intersect(index, ray, t_max).is_some() {
             found.blocked = true;
         }
         return found.blocked;
     }
-    for &t in shape.crossings(ray, t_max).as_slice() {
+    // Transparent shapes are two-sided (light passes in and out).
+    for &t in prims.shapes[index as usize]
+        .crossings(ray, t_max)
+        .as_slice()
+    {
         found.add(t, index);
     }
     false
@@ -182,15 +224,14 @@ pub(crate) fn test_occlusion<C: Counter>(
 
 /// Everything in `(0, t_max)`, testing every shape; stops at the first opaque one.
 pub fn occlusion_brute_force<C: Counter>(
-    shapes: &[Shape],
-    is_transparent: &[bool],
+    prims: &Primitives,
     ray: &PreparedRay,
     t_max: f64,
     counter: &mut C,
 ) -> ShadowCrossings {
     let mut found = ShadowCrossings::default();
-    for i in 0..shapes.len() as u32 {
-        if test_occlusion(shapes, is_transparent, i, ray, t_max, &mut found, counter) {
+    for i in 0..prims.shapes.len() as u32 {
+        if test_occlusion(prims, i, ray, t_max, &mut found, counter) {
             break;
         }
     }

@@ -25,7 +25,7 @@
 
 use rayon::prelude::*;
 
-use super::{ClosestHit, ShadowCrossings, test_closest, test_occlusion};
+use super::{ClosestHit, Primitives, ShadowCrossings, test_closest, test_occlusion};
 use crate::math::{Aabb, DVec3};
 use crate::shapes::{PreparedRay, Shape};
 use crate::stats::Counter;
@@ -338,13 +338,13 @@ impl Octree {
     /// Closest hit with `0 < t < t_max`.
     pub fn closest<C: Counter>(
         &self,
-        shapes: &[Shape],
+        prims: &Primitives,
         ray: &PreparedRay,
         t_max: f64,
         counter: &mut C,
     ) -> Option<ClosestHit> {
         let mut visitor = ClosestVisitor {
-            shapes,
+            prims,
             ray,
             best: None,
             t_max,
@@ -352,7 +352,7 @@ impl Octree {
             counter,
         };
         for &i in &self.unbounded {
-            test_closest(shapes, i, ray, &mut visitor.best, t_max, visitor.counter);
+            test_closest(prims, i, ray, &mut visitor.best, t_max, visitor.counter);
         }
         let limit = visitor.best.map_or(t_max, |b| b.hit.t);
         self.traverse(ray, limit, &mut visitor);
@@ -362,15 +362,13 @@ impl Octree {
     /// What a shadow ray meets over `(0, t_max)`.
     pub fn occlusion<C: Counter>(
         &self,
-        shapes: &[Shape],
-        is_transparent: &[bool],
+        prims: &Primitives,
         ray: &PreparedRay,
         t_max: f64,
         counter: &mut C,
     ) -> ShadowCrossings {
         let mut visitor = OcclusionVisitor {
-            shapes,
-            is_transparent,
+            prims,
             ray,
             t_max,
             found: ShadowCrossings::default(),
@@ -378,15 +376,7 @@ impl Octree {
             counter,
         };
         for &i in &self.unbounded {
-            if test_occlusion(
-                shapes,
-                is_transparent,
-                i,
-                ray,
-                t_max,
-                &mut visitor.found,
-                visitor.counter,
-            ) {
+            if test_occlusion(prims, i, ray, t_max, &mut visitor.found, visitor.counter) {
                 return visitor.found;
             }
         }
@@ -574,7 +564,7 @@ trait LeafVisitor {
 }
 
 struct ClosestVisitor<'a, C> {
-    shapes: &'a [Shape],
+    prims: &'a Primitives<'a>,
     ray: &'a PreparedRay,
     best: Option<ClosestHit>,
     t_max: f64,
@@ -593,7 +583,7 @@ impl<C: Counter> LeafVisitor for ClosestVisitor<'_, C> {
         for &i in refs {
             if !self.mailbox.seen(i) {
                 test_closest(
-                    self.shapes,
+                    self.prims,
                     i,
                     self.ray,
                     &mut self.best,
@@ -613,8 +603,7 @@ impl<C: Counter> LeafVisitor for ClosestVisitor<'_, C> {
 }
 
 struct OcclusionVisitor<'a, C> {
-    shapes: &'a [Shape],
-    is_transparent: &'a [bool],
+    prims: &'a Primitives<'a>,
     ray: &'a PreparedRay,
     t_max: f64,
     found: ShadowCrossings,
@@ -633,8 +622,7 @@ impl<C: Counter> LeafVisitor for OcclusionVisitor<'_, C> {
         for &i in refs {
             if !self.mailbox.seen(i)
                 && test_occlusion(
-                    self.shapes,
-                    self.is_transparent,
+                    self.prims,
                     i,
                     self.ray,
                     self.t_max,

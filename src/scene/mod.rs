@@ -11,11 +11,48 @@ use std::path::{Path, PathBuf};
 
 use crate::accel::OctreeParams;
 use crate::camera::CameraSpec;
+use crate::color::ColorConvention;
 use crate::material::{Light, Material};
 use crate::math::{Aabb, Color, DVec3};
 use crate::shapes::{Shape, Triangle};
 
 pub use polygon::DroppedPolygons;
+
+/// Which sides of a surface rays can hit.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Sides {
+    /// Every surface is seen from both sides (glint's default).
+    #[default]
+    Two,
+    /// Opaque surfaces are seen from outside only, as the SPD allows (a
+    /// ray meeting one from behind passes on). Transparent surfaces, and
+    /// triangles with vertex normals (NFF `pp` patches, smooth meshes:
+    /// tessellated open surfaces such as the SPD's teapot, which the SPD
+    /// requires two-sided) stay two-sided.
+    One,
+}
+
+impl Sides {
+    pub const ALL: [Sides; 2] = [Sides::Two, Sides::One];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Sides::Two => "two",
+            Sides::One => "one",
+        }
+    }
+}
+
+impl std::str::FromStr for Sides {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|p| p.name() == s)
+            .ok_or_else(|| format!("unknown sidedness `{s}` (expected one or two)"))
+    }
+}
 
 /// Image and recursion settings stored with a scene; command-line flags and
 /// the viewer override them.
@@ -29,6 +66,10 @@ pub struct ImageSettings {
     pub max_depth: u32,
     pub background: Color,
     pub ambient: Color,
+    /// How colours are shaded and written: linear (glint's TOML default)
+    /// or display values (the NFF default).
+    pub colors: ColorConvention,
+    pub sides: Sides,
 }
 
 impl Default for ImageSettings {
@@ -40,6 +81,8 @@ impl Default for ImageSettings {
             max_depth: 5,
             background: DVec3::ZERO,
             ambient: DVec3::splat(0.1),
+            colors: ColorConvention::Linear,
+            sides: Sides::Two,
         }
     }
 }
@@ -64,6 +107,9 @@ pub struct Scene {
     pub dropped_triangles: usize,
     /// Polygons dropped while loading: zero area, or not simple.
     pub dropped_polygons: DroppedPolygons,
+    /// What the file's colour numbers are: linear light (TOML) or display
+    /// values (NFF); a render in the other convention converts them.
+    pub color_values: ColorConvention,
     /// The text the scene was parsed from, kept for reproducible exports
     /// (empty for scenes built in code).
     pub source_text: String,
@@ -85,6 +131,7 @@ impl Scene {
             vertex_normals: Vec::new(),
             dropped_triangles: 0,
             dropped_polygons: DroppedPolygons::default(),
+            color_values: ColorConvention::Linear,
             source_text: String::new(),
         }
     }

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use super::{ImageSettings, Location, Scene, SceneError};
 use crate::camera::CameraSpec;
+use crate::color::ColorConvention;
 use std::ops::RangeInclusive;
 
 use crate::material::{
@@ -181,27 +182,16 @@ pub fn fov_from_nff_angle(angle_degrees: f64, rows: u32) -> f64 {
     2.0 * half.atan().to_degrees()
 }
 
-/// NFF colours are display values (the SPD images were shown without any
-/// transfer function), so glint decodes them as sRGB into linear RGB.
-fn srgb_to_linear(c: DVec3) -> DVec3 {
-    let decode = |x: f64| {
-        let x = x.clamp(0.0, 1.0);
-        if x <= 0.040_45 {
-            x / 12.92
-        } else {
-            ((x + 0.055) / 1.055).powf(2.4)
-        }
-    };
-    DVec3::new(decode(c.x), decode(c.y), decode(c.z))
-}
-
 pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
     let mut tokens = Tokens::new(text, path);
     let mut camera: Option<CameraSpec> = None;
+    // NFF colours are display values: the SPD's pictures were shaded and
+    // shown with no transfer function, and glint does the same by default.
     let mut image = ImageSettings {
         samples: 1,
         max_depth: 5,
         background: DVec3::ZERO,
+        colors: ColorConvention::Display,
         ..ImageSettings::default()
     };
     // Lights given without a colour; their intensity depends on the final count.
@@ -216,6 +206,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
         },
         image.clone(),
     );
+    scene.color_values = ColorConvention::Display;
     let mut material: Option<u32> = None;
 
     while tokens.next < tokens.tokens.len() {
@@ -274,10 +265,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
                     fov: fov_from_nff_angle(angle, h as u32),
                 });
             }
-            "b" => {
-                image.background =
-                    srgb_to_linear(tokens.color_in("background colour", &UNIT_RANGE)?)
-            }
+            "b" => image.background = tokens.color_in("background colour", &UNIT_RANGE)?,
             "l" => {
                 let position = tokens.vec3("light position")?;
                 // The colour is optional: it is present if the next token is a number.
@@ -297,7 +285,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 }
             }
             "f" => {
-                let color = srgb_to_linear(tokens.color_in("colour", &UNIT_RANGE)?);
+                let color = tokens.color_in("colour", &UNIT_RANGE)?;
                 let kd = tokens.number_in("Kd", &UNIT_RANGE)?;
                 let ks = tokens.number_in("Ks", &UNIT_RANGE)?;
                 let shininess = tokens.number_in("Shine", &SHININESS_RANGE)?;
@@ -456,10 +444,9 @@ pp 3
         let expected = 2f64.sqrt() / 4.0;
         assert!((s.lights[0].color - DVec3::splat(expected)).length() < 1e-15);
         assert_eq!(s.lights[1].color, DVec3::X);
-        assert!(
-            (s.image.background.z - 0.073).abs() < 1e-3,
-            "sRGB 0.3 is linear 0.073"
-        );
+        // Display values, kept as written.
+        assert_eq!(s.image.background, DVec3::new(0.1, 0.2, 0.3));
+        assert_eq!(s.image.colors, ColorConvention::Display);
         assert_eq!(s.materials.len(), 1);
         assert_eq!(s.materials[0].reflectivity, 0.3);
         assert_eq!(s.vertex_normals.len(), 1);

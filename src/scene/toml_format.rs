@@ -54,6 +54,8 @@ struct ImageFile {
     max_depth: Option<Spanned<i64>>,
     background: Option<Vec3>,
     ambient: Option<Vec3>,
+    colors: Option<Spanned<String>>,
+    sides: Option<Spanned<String>>,
 }
 
 #[derive(Deserialize, Default)]
@@ -242,6 +244,18 @@ pub fn parse(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, S
     }
     if let Some(v) = &im.ambient {
         image.ambient = cx.color(v, "image.ambient", &INTENSITY_RANGE)?;
+    }
+    if let Some(v) = &im.colors {
+        image.colors = v
+            .get_ref()
+            .parse()
+            .map_err(|e: String| cx.error(v.span(), "image.colors", e))?;
+    }
+    if let Some(v) = &im.sides {
+        image.sides = v
+            .get_ref()
+            .parse()
+            .map_err(|e: String| cx.error(v.span(), "image.sides", e))?;
     }
 
     let mut octree_params = OctreeParams::default();

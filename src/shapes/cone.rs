@@ -88,6 +88,15 @@ impl Cone {
         out
     }
 
+    /// A vector along the outward normal at a point on the surface (the
+    /// gradient of `|q_perp|^2 - r(z)^2`, up to a factor of 2).
+    pub fn outward(&self, p: DVec3) -> DVec3 {
+        let q = p - self.base;
+        let z = q.dot(self.axis);
+        let q_perp = q - z * self.axis;
+        q_perp - self.slope * (self.base_radius + self.slope * z) * self.axis
+    }
+
     pub fn surface(&self, ray: &Ray, hit: &ShapeHit) -> Surface {
         let p = ray.at(hit.t);
         let q = p - self.base;

@@ -134,6 +134,48 @@ impl Shape {
         }
     }
 
+    /// The nearest hit with `0 < t < t_max` on the outside of the surface:
+    /// a one-sided shape is invisible from behind (the SPD's rule for opaque
+    /// primitives). The outside of a triangle is the side from which its
+    /// vertices run counter-clockwise; of a quadric, where `F > 0`.
+    #[inline]
+    pub fn intersect_front(&self, ray: &PreparedRay, t_max: f64) -> Option<ShapeHit> {
+        let d = ray.ray.dir;
+        let front = |outward: DVec3| d.dot(outward) < 0.0;
+        match self {
+            Shape::Triangle(t) => {
+                let [a, b, c] = t.vertices;
+                if !front((b - a).cross(c - a)) {
+                    return None;
+                }
+                t.intersect(ray, t_max)
+            }
+            Shape::Plane(p) => {
+                if !front(p.normal) {
+                    return None;
+                }
+                p.intersect(&ray.ray, t_max)
+            }
+            _ => {
+                let outward = |t: f64| {
+                    let p = ray.ray.at(t);
+                    match self {
+                        Shape::Sphere(s) => p - s.center,
+                        Shape::Quadric(q) => q.gradient(p),
+                        Shape::Cone(c) => c.outward(p),
+                        Shape::Triangle(_) | Shape::Plane(_) => DVec3::ZERO,
+                    }
+                };
+                self.crossings(ray, t_max)
+                    .as_slice()
+                    .iter()
+                    .copied()
+                    .find(|&t| front(outward(t)))
+                    .map(ShapeHit::at)
+            }
+        }
+    }
+
     /// Every crossing of the surface with `0 < t < t_max`, nearest first:
     /// what a shadow ray needs to attenuate light once per surface crossed.
     #[inline]
@@ -184,6 +226,12 @@ impl Shape {
             Shape::Triangle(t) => triangle_overlaps_box(&t.vertices, b),
             _ => self.bounds().is_none_or(|sb| sb.overlaps(b)),
         }
+    }
+
+    /// Whether the shape is a triangle shaded with vertex normals: a piece
+    /// of a tessellated curved surface (NFF `pp`, smooth meshes).
+    pub fn has_vertex_normals(&self) -> bool {
+        matches!(self, Shape::Triangle(t) if t.vertex_normals != triangle::NO_NORMALS)
     }
 
     pub fn kind_name(&self) -> &'static str {

@@ -67,6 +67,11 @@ pub struct ViewerOptions {
     pub compare: Option<CompareSetting>,
     /// Show the comparison as a difference rather than a split.
     pub compare_difference: bool,
+    /// Start with these rules instead of the scene's (the protocol first:
+    /// it sets its depth and sidedness).
+    pub protocol: Option<crate::render::Protocol>,
+    pub colors: Option<crate::color::ColorConvention>,
+    pub sides: Option<crate::render::Sides>,
 }
 
 /// A setting `--compare` flips for the A image.
@@ -153,6 +158,15 @@ impl GlintApp {
         }
         if let Some((w, h)) = options.size {
             (settings.width, settings.height) = (w, h);
+        }
+        if let Some(p) = options.protocol {
+            settings = settings.with_protocol(p);
+        }
+        if let Some(c) = options.colors {
+            settings.colors = c;
+        }
+        if let Some(s) = options.sides {
+            settings.sides = s;
         }
         let (octree, build_seconds) = build_octree(&scene)?;
         let mut anti_aliasing = anti_aliasing;
@@ -295,7 +309,11 @@ impl GlintApp {
         if !self.dragging {
             return 1;
         }
-        let Some(last) = history.iter().rev().find(|r| r.kind == PassKind::OneSample) else {
+        let Some(last) = history
+            .iter()
+            .rev()
+            .find(|r| matches!(r.kind, PassKind::OneSample | PassKind::Corners))
+        else {
             return 4;
         };
         let pixels_now = self.settings.width as f64 * self.settings.height as f64;
@@ -418,12 +436,15 @@ impl GlintApp {
         let (octree, seconds) = build_octree(&scene)?;
         if take_camera {
             self.camera = scene.camera;
+            // The new scene's own settings (its colour convention among
+            // them), keeping the view, the octree switch and the protocol.
             let keep_view = self.settings.view;
             self.settings = RenderSettings {
                 view: keep_view,
                 use_octree: self.settings.use_octree,
                 ..RenderSettings::from_scene(&scene)
-            };
+            }
+            .with_protocol(self.settings.protocol);
         }
         self.octree = Arc::new(octree);
         self.build_seconds = seconds;

@@ -6,8 +6,9 @@ use egui_plot::{Legend, Line, Plot, Points};
 
 use super::app::{Command, GlintApp};
 use super::worker::PassKind;
+use crate::color::ColorConvention;
 use crate::math::DVec3;
-use crate::render::ViewMode;
+use crate::render::{Protocol, RenderSettings, Sides, ViewMode};
 
 pub fn menu_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
     egui::MenuBar::new().ui(ui, |ui| {
@@ -81,14 +82,64 @@ pub fn controls_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
         egui::CollapsingHeader::new("Render settings")
             .default_open(true)
             .show(ui, |ui| {
-                ui.checkbox(
-                    &mut app.anti_aliasing,
-                    "Anti-aliasing (16 samples, 4x4 grid)",
+                let spd = app.settings.protocol == Protocol::Spd;
+                ui.horizontal(|ui| {
+                    ui.label("Protocol");
+                    let mut protocol = app.settings.protocol;
+                    for p in Protocol::ALL {
+                        ui.selectable_value(&mut protocol, p, p.name())
+                            .on_hover_text(match p {
+                                Protocol::Glint => "pixel centres (or the 4x4 grid with anti-aliasing)",
+                                Protocol::Spd => "the SPD test protocol: rays through the pixel corners, depth 5, a reflection ray from every reflective or transmitting surface, opaque surfaces one-sided",
+                            });
+                    }
+                    if protocol != app.settings.protocol {
+                        app.settings = match protocol {
+                            // Back to glint's rules: the scene's own depth and sidedness.
+                            Protocol::Glint => RenderSettings {
+                                protocol,
+                                max_depth: app.scene.image.max_depth,
+                                sides: app.scene.image.sides,
+                                ..app.settings
+                            },
+                            Protocol::Spd => app.settings.with_protocol(protocol),
+                        };
+                    }
+                });
+                ui.add_enabled(
+                    !spd,
+                    egui::Checkbox::new(
+                        &mut app.anti_aliasing,
+                        "Anti-aliasing (16 samples, 4x4 grid)",
+                    ),
                 );
                 ui.checkbox(&mut app.settings.use_octree, "Octree");
                 ui.horizontal(|ui| {
                     ui.label("Max depth");
-                    ui.add(DragValue::new(&mut app.settings.max_depth).range(1..=64));
+                    ui.add_enabled(
+                        !spd,
+                        DragValue::new(&mut app.settings.max_depth).range(1..=64),
+                    );
+                });
+                ui.horizontal(|ui| {
+                    ui.label("Colours");
+                    for c in ColorConvention::ALL {
+                        ui.selectable_value(&mut app.settings.colors, c, c.name())
+                            .on_hover_text(match c {
+                                ColorConvention::Linear => "shade in linear light, show sRGB-encoded",
+                                ColorConvention::Display => "shade display values, show them unchanged (the SPD's pictures)",
+                            });
+                    }
+                });
+                ui.horizontal(|ui| {
+                    ui.label("Sides");
+                    for side in Sides::ALL {
+                        ui.selectable_value(&mut app.settings.sides, side, side.name())
+                            .on_hover_text(match side {
+                                Sides::Two => "every surface seen from both sides",
+                                Sides::One => "opaque surfaces seen from outside only (patches with vertex normals stay two-sided)",
+                            });
+                    }
                 });
                 ui.horizontal(|ui| {
                     ui.label("Image size");
@@ -239,6 +290,9 @@ fn timing_grid_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                 ui.label(value);
                 ui.end_row();
             };
+            if let Some(r) = last(PassKind::Corners) {
+                row("SPD corner pass", format!("{:.3} s", r.seconds));
+            }
             match last(PassKind::OneSample) {
                 Some(r) => row("1-sample pass", format!("{:.3} s", r.seconds)),
                 None => row("1-sample pass", "–".into()),
@@ -256,7 +310,10 @@ fn timing_grid_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                 if let Some(e) = b.one_sample_error {
                     row(
                         "1-sample error vs 16",
-                        format!("RMSE {:.4}, PSNR {:.1} dB (sRGB)", e.rmse_srgb, e.psnr_srgb),
+                        format!(
+                            "RMSE {:.4}, PSNR {:.1} dB (displayed)",
+                            e.rmse_display, e.psnr_display
+                        ),
                     );
                     row(
                         "pixels AA changes",

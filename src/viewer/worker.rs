@@ -38,9 +38,13 @@ pub struct Job {
 /// Which pass produced a buffer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PassKind {
-    Preview { divisor: u32 },
+    Preview {
+        divisor: u32,
+    },
     OneSample,
     SixteenSamples,
+    /// The SPD protocol's one pass: rays through the pixel corners.
+    Corners,
 }
 
 impl PassKind {
@@ -49,6 +53,7 @@ impl PassKind {
             PassKind::Preview { divisor } => format!("preview 1/{divisor}"),
             PassKind::OneSample => "1 sample".into(),
             PassKind::SixteenSamples => "16 samples".into(),
+            PassKind::Corners => "SPD corners".into(),
         }
     }
 }
@@ -277,6 +282,9 @@ fn render_job(shared: &Shared, generation: u64, job: &Job) {
         vec![PassKind::Preview {
             divisor: job.preview_divisor,
         }]
+    } else if job.settings.corner_rays() {
+        // The SPD protocol has one way to sample: no refinement pass.
+        vec![PassKind::Corners]
     } else if job.anti_aliasing {
         vec![PassKind::OneSample, PassKind::SixteenSamples]
     } else {
@@ -368,7 +376,7 @@ fn render_pass(
             }
             count_tile(shared, generation);
             let (values, counts) = renderer.render_tile(tile, false);
-            let rgba = tile_rgba(&values, settings.view, &depth_range);
+            let rgba = tile_rgba(&values, &settings, &depth_range);
             {
                 let mut b = shared.buffer.lock().unwrap_or_else(|e| e.into_inner());
                 if b.generation == generation && b.width == w {
@@ -392,7 +400,7 @@ fn render_pass(
     let seconds = start.elapsed().as_secs_f64();
     // Assemble the exact frame, as `glint render` would, and publish it.
     let (frame, counts) =
-        crate::render::assemble_tiles(w, h, settings.view, &all, results.into_iter().flatten());
+        crate::render::assemble_tiles(&settings, &all, results.into_iter().flatten());
     let one_sample_error = {
         let mut one = shared.one_sample.lock().unwrap_or_else(|e| e.into_inner());
         match kind {
@@ -403,8 +411,8 @@ fn render_pass(
             PassKind::SixteenSamples => one
                 .as_ref()
                 .filter(|(g, f)| *g == generation && f.pixels.len() == frame.pixels.len())
-                .map(|(_, f)| crate::render::image_error(&f.pixels, &frame.pixels)),
-            PassKind::Preview { .. } => None,
+                .map(|(_, f)| crate::render::image_error(&f.pixels, &frame.pixels, frame.colors)),
+            PassKind::Preview { .. } | PassKind::Corners => None,
         }
     };
     let frame = match (shown_view, kind) {
@@ -468,7 +476,12 @@ fn count_tile(shared: &Shared, generation: u64) {
 /// Display bytes of one tile. Depth is normalised by the nearest distance
 /// seen so far, cost by the range seen so far; the finished pass replaces
 /// them with the exact full frame.
-fn tile_rgba(values: &[DVec3], view: ViewMode, depth_range: &Mutex<(f64, f64)>) -> Vec<u8> {
+fn tile_rgba(
+    values: &[DVec3],
+    settings: &RenderSettings,
+    depth_range: &Mutex<(f64, f64)>,
+) -> Vec<u8> {
+    let view = settings.view;
     let rgb = match view {
         ViewMode::Cost | ViewMode::CostSteps => {
             let range = {
@@ -507,6 +520,7 @@ fn tile_rgba(values: &[DVec3], view: ViewMode, depth_range: &Mutex<(f64, f64)>) 
             width: values.len() as u32,
             height: 1,
             view,
+            colors: settings.colors,
             pixels: values.to_vec(),
         }
         .to_rgb8(),

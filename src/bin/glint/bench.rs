@@ -9,7 +9,7 @@ use glint::render::{RenderSettings, Renderer, TileCounts};
 use serde::Serialize;
 
 use crate::common::{
-    OctreeArgs, load_scene, parse_positive, parse_samples, parse_size, thread_pool,
+    OctreeArgs, RulesArgs, load_scene, parse_positive, parse_samples, parse_size, thread_pool,
 };
 
 #[derive(clap::Args)]
@@ -20,12 +20,15 @@ pub struct BenchArgs {
     /// Image size as WIDTHxHEIGHT (default: each scene's own).
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
-    /// Rays per pixel: 1 or 16 (default: each scene's own).
+    /// Rays per pixel: 1 or 16 (default: each scene's own); the SPD
+    /// protocol shoots the pixel corners instead.
     #[arg(long, value_parser = parse_samples)]
     pub samples: Option<u32>,
-    /// Longest ray path (default: each scene's own).
+    /// Longest ray path (default: each scene's own; the SPD protocol fixes 5).
     #[arg(long, value_parser = parse_positive)]
     pub max_depth: Option<u32>,
+    #[command(flatten)]
+    pub rules: RulesArgs,
     /// Timed runs of each configuration; medians are reported.
     #[arg(long, default_value_t = 3, value_parser = parse_positive)]
     pub repeat: u32,
@@ -102,8 +105,46 @@ struct SceneBench {
     compared_rows_every: u32,
     /// Render time with work counting on over off (octree on, whole image).
     counting_overhead: f64,
-    /// Rays per pixel the scene needs, by kind.
+    /// Rays the image needs (all kinds).
     rays_total: u64,
+    /// Rays by kind (eye rays, those that hit, shadow, reflection, refraction).
+    rays: glint::stats::RayCounts,
+    protocol: glint::render::Protocol,
+    /// The SPD's published counts for this scene (default SPD scenes at
+    /// 512x512 under `--protocol spd` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    published: Option<PublishedCounts>,
+}
+
+/// Ray counts the SPD Readme publishes for its default scenes (513 x 513
+/// eye rays; `spd_protocol.md`), which a ray tracer following its rules
+/// should reproduce within about 10%.
+#[derive(Clone, Copy, Debug, Serialize)]
+struct PublishedCounts {
+    eye_hits: u64,
+    reflection: u64,
+    refraction: u64,
+    shadow: u64,
+}
+
+fn published_counts(scene: &str) -> Option<PublishedCounts> {
+    let name = std::path::Path::new(scene).file_stem()?.to_str()?;
+    let (eye_hits, reflection, refraction, shadow) = match name {
+        "balls" => (263_169, 175_095, 0, 954_368),
+        "gears" => (245_086, 304_643, 207_564, 2_246_955),
+        "mount" => (173_125, 354_769, 354_769, 412_922),
+        "rings" => (263_169, 315_236, 0, 1_085_002),
+        "teapot" => (161_120, 225_248, 0, 407_656),
+        "tetra" => (49_788, 0, 0, 46_112),
+        "tree" => (169_836, 0, 0, 1_097_419),
+        _ => return None,
+    };
+    Some(PublishedCounts {
+        eye_hits,
+        reflection,
+        refraction,
+        shadow,
+    })
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -123,6 +164,7 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
 }
 
 pub fn run(args: &BenchArgs) -> Result<()> {
+    args.rules.check(args.max_depth, args.samples)?;
     if args.sweep {
         return sweep(args);
     }
@@ -227,6 +269,12 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             compared_rows_every: every,
             counting_overhead: median(counted_times) / on_s,
             rays_total,
+            rays: counted_on.rays,
+            protocol: settings.protocol,
+            published: (settings.protocol == glint::render::Protocol::Spd
+                && (settings.width, settings.height) == (512, 512))
+                .then(|| published_counts(&path.display().to_string()))
+                .flatten(),
         });
         if every > 1 {
             // Report the whole-image estimate, with throughput measured on the subset.
@@ -237,7 +285,12 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     }
     match args.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&results)?),
-        Format::Markdown => print!("{}", markdown(&results)),
+        Format::Markdown => {
+            print!("{}", markdown(&results));
+            if results.iter().any(|r| r.published.is_some()) {
+                print!("\n{}", counts_markdown(&results));
+            }
+        }
     }
     Ok(())
 }
@@ -282,7 +335,11 @@ fn markdown(results: &[SceneBench]) -> String {
             r.shapes,
             r.width,
             r.height,
-            r.samples,
+            if r.protocol == glint::render::Protocol::Spd {
+                "corners".to_string()
+            } else {
+                r.samples.to_string()
+            },
             r.build_s,
             r.octree_on.render_s,
             off,
@@ -293,6 +350,45 @@ fn markdown(results: &[SceneBench]) -> String {
             r.octree_on.leaves_visited_per_ray,
             havran,
             r.counting_overhead,
+        ));
+    }
+    s
+}
+
+/// glint's ray counts beside the SPD's published ones, with the relative
+/// difference.
+fn counts_markdown(results: &[SceneBench]) -> String {
+    let mut s = String::from(
+        "| scene | eye rays | eye rays that hit (SPD) | diff | reflection (SPD) | diff | refraction (SPD) | diff | shadow (SPD) | diff |\n\
+         |---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+    );
+    let cell = |ours: u64, theirs: u64| {
+        let diff = if theirs == 0 {
+            if ours == 0 {
+                "0%".to_string()
+            } else {
+                "n/a".to_string()
+            }
+        } else {
+            format!(
+                "{:+.1}%",
+                100.0 * (ours as f64 - theirs as f64) / theirs as f64
+            )
+        };
+        (format!("{ours} ({theirs})"), diff)
+    };
+    for r in results {
+        let Some(p) = r.published else { continue };
+        let name = std::path::Path::new(&r.scene)
+            .file_stem()
+            .map_or(r.scene.clone(), |n| n.to_string_lossy().into_owned());
+        let (a, da) = cell(r.rays.primary_hits, p.eye_hits);
+        let (b, db) = cell(r.rays.reflection, p.reflection);
+        let (c, dc) = cell(r.rays.refraction, p.refraction);
+        let (d, dd) = cell(r.rays.shadow, p.shadow);
+        s.push_str(&format!(
+            "| {name} | {} | {a} | {da} | {b} | {db} | {c} | {dc} | {d} | {dd} |\n",
+            r.rays.primary
         ));
     }
     s
@@ -424,5 +520,6 @@ fn bench_settings(args: &BenchArgs, scene: &mut glint::scene::Scene) -> RenderSe
     }
     settings.samples = args.samples.unwrap_or(settings.samples);
     settings.max_depth = args.max_depth.unwrap_or(settings.max_depth);
+    args.rules.apply(&mut settings);
     settings
 }

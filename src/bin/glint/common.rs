@@ -70,6 +70,58 @@ pub fn parse_positive(s: &str) -> std::result::Result<u32, String> {
     }
 }
 
+/// How rays are cast and colours shaded; unset ones keep the scene's.
+#[derive(clap::Args, Clone, Copy, Debug, Default)]
+pub struct RulesArgs {
+    /// The rules rays are cast by: glint (pixel centres or a regular grid)
+    /// or spd (the SPD test protocol: rays through the 513x513 pixel
+    /// corners of a 512x512 image, depth 5, a reflection ray from every
+    /// reflective or transmitting surface, opaque surfaces one-sided).
+    #[arg(long, value_parser = |s: &str| s.parse::<glint::render::Protocol>())]
+    pub protocol: Option<glint::render::Protocol>,
+    /// Colour convention: linear (shade in linear light, write sRGB; the
+    /// default for TOML scenes) or display (shade display values, write
+    /// them unchanged; the default for NFF scenes).
+    #[arg(long, value_parser = |s: &str| s.parse::<glint::color::ColorConvention>())]
+    pub colors: Option<glint::color::ColorConvention>,
+    /// Sidedness: two (every surface seen from both sides; glint's default)
+    /// or one (opaque surfaces seen from outside only; the SPD protocol's
+    /// default, which keeps patches with vertex normals two-sided).
+    #[arg(long, value_parser = |s: &str| s.parse::<glint::render::Sides>())]
+    pub sides: Option<glint::render::Sides>,
+}
+
+impl RulesArgs {
+    /// Refuses settings the SPD protocol fixes itself.
+    pub fn check(&self, max_depth: Option<u32>, samples: Option<u32>) -> Result<()> {
+        if self.protocol == Some(glint::render::Protocol::Spd) {
+            anyhow::ensure!(
+                max_depth.is_none(),
+                "--protocol spd fixes the ray depth at 5: drop --max-depth"
+            );
+            anyhow::ensure!(
+                samples.is_none(),
+                "--protocol spd shoots the pixel corners (each pixel the mean of four): drop --samples"
+            );
+        }
+        Ok(())
+    }
+
+    /// Applies the flags: the protocol first (it sets its depth and
+    /// sidedness), then explicit colour and sidedness choices.
+    pub fn apply(&self, settings: &mut glint::render::RenderSettings) {
+        if let Some(p) = self.protocol {
+            *settings = settings.with_protocol(p);
+        }
+        if let Some(c) = self.colors {
+            settings.colors = c;
+        }
+        if let Some(s) = self.sides {
+            settings.sides = s;
+        }
+    }
+}
+
 /// Octree parameters on the command line; unset ones keep the scene's.
 #[derive(clap::Args, Clone, Copy, Debug, Default)]
 pub struct OctreeArgs {

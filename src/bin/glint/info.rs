@@ -51,16 +51,25 @@ fn write_info(
     writeln!(out, "scene         {}", record.scene_path)?;
     writeln!(out, "scene sha256  {}", record.scene_sha256)?;
     writeln!(out, "size          {}x{}", r.width, r.height)?;
-    writeln!(out, "samples       {}", r.samples)?;
+    if r.corner_rays() {
+        writeln!(out, "samples       pixel corners (SPD protocol)")?;
+    } else {
+        writeln!(out, "samples       {}", r.samples)?;
+    }
     writeln!(out, "max depth     {}", r.max_depth)?;
     writeln!(out, "view          {}", r.view.name())?;
+    writeln!(out, "protocol      {}", r.protocol.name())?;
+    writeln!(out, "colours       {}", r.colors.name())?;
+    writeln!(out, "sides         {}", r.sides.name())?;
     writeln!(
         out,
-        "octree        {} (max depth {}, leaf size {}, cost-driven {})",
+        "octree        {} (max depth {}, leaf size {}, cost-driven {}, max duplication {}, budget {} MiB)",
         if r.use_octree { "on" } else { "off" },
         s.octree_params.max_depth,
         s.octree_params.leaf_size,
-        s.octree_params.cost_driven
+        s.octree_params.cost_driven,
+        s.octree_params.max_duplication,
+        s.octree_params.memory_budget_mib
     )?;
     writeln!(out, "camera eye    {}", v3(s.camera.eye))?;
     writeln!(out, "camera lookat {}", v3(s.camera.lookat))?;

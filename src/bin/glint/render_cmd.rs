@@ -11,7 +11,8 @@ use glint::stats::RayCounts;
 use serde::Serialize;
 
 use crate::common::{
-    OctreeArgs, Switch, load_scene, parse_pixel, parse_positive, parse_samples, thread_pool,
+    OctreeArgs, RulesArgs, Switch, load_scene, parse_pixel, parse_positive, parse_samples,
+    thread_pool,
 };
 
 #[derive(clap::Args)]
@@ -28,12 +29,15 @@ pub struct RenderArgs {
     /// Image height in pixels (default: the scene's).
     #[arg(long, value_parser = parse_positive)]
     pub height: Option<u32>,
-    /// Rays per pixel: 1 (pixel centre) or 16 (regular 4x4 grid).
+    /// Rays per pixel: 1 (pixel centre) or 16 (regular 4x4 grid); the SPD
+    /// protocol shoots the pixel corners instead.
     #[arg(long, value_parser = parse_samples)]
     pub samples: Option<u32>,
-    /// Longest ray path; the eye ray is depth 1.
+    /// Longest ray path; the eye ray is depth 1 (the SPD protocol fixes 5).
     #[arg(long, value_parser = parse_positive)]
     pub max_depth: Option<u32>,
+    #[command(flatten)]
+    pub rules: RulesArgs,
     /// Use the octree (default: the scene's setting, on unless it says otherwise).
     #[arg(long, value_enum)]
     pub octree: Option<Switch>,
@@ -83,7 +87,11 @@ struct TraceJson<'a> {
     height: u32,
     max_depth: u32,
     octree: bool,
-    /// The pixel's value at 1 sample (linear RGB) and as written to PNG.
+    /// Under `spd` the tree is the pixel's top-left corner ray's.
+    protocol: glint::render::Protocol,
+    colors: glint::color::ColorConvention,
+    /// The pixel's value at 1 sample (shading values) and as written to
+    /// PNG (encoded by the colour convention; the name is historical).
     color: [f64; 3],
     srgb8: [u8; 3],
     lights: Vec<LightJson>,
@@ -109,6 +117,9 @@ struct RenderStats {
     octree: bool,
     octree_params: glint::accel::OctreeParams,
     view: ViewMode,
+    protocol: glint::render::Protocol,
+    colors: glint::color::ColorConvention,
+    sides: glint::render::Sides,
     load_s: f64,
     build_s: f64,
     render_s: f64,
@@ -143,6 +154,7 @@ struct RaysJson {
 }
 
 pub fn run(args: &RenderArgs) -> Result<()> {
+    args.rules.check(args.max_depth, args.samples)?;
     let load_start = Instant::now();
     let mut overlay_depth = args.overlay.map(|_| args.overlay_depth.unwrap_or(4));
     let (mut scene, scene_name, mut settings, camera) = match (&args.from_png, &args.scene) {
@@ -193,6 +205,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     settings.max_depth = args.max_depth.unwrap_or(settings.max_depth);
     settings.use_octree = args.octree.map_or(settings.use_octree, Switch::is_on);
     settings.view = args.view.unwrap_or(settings.view);
+    args.rules.apply(&mut settings);
 
     let pool = thread_pool(args.threads)?;
     let threads = pool.current_num_threads();
@@ -300,6 +313,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             octree: settings.use_octree,
             octree_params: scene.octree_params,
             view: settings.view,
+            protocol: settings.protocol,
+            colors: settings.colors,
+            sides: settings.sides,
             load_s,
             build_s,
             render_s,
@@ -347,8 +363,8 @@ fn print_ray_tree(
         .with_context(|| format!("cannot render {scene_name}"))?;
     let tree = renderer.ray_tree(x, y);
     let color = glam::DVec3::from_array(tree.color);
-    let srgb8 = [color.x, color.y, color.z]
-        .map(|c| (glint::render::linear_to_srgb(c) * 255.0).round() as u8);
+    let srgb8 =
+        [color.x, color.y, color.z].map(|c| glint::color::to_byte(settings.colors.encode(c)));
     let out = TraceJson {
         scene: scene_name.to_string(),
         pixel: [x, y],
@@ -356,6 +372,8 @@ fn print_ray_tree(
         height: settings.height,
         max_depth: settings.max_depth,
         octree: settings.use_octree,
+        protocol: settings.protocol,
+        colors: settings.colors,
         color: tree.color,
         srgb8,
         lights: scene

@@ -150,7 +150,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
         )?;
         writeln!(
             md,
-            "| samples | grid | time (s) | time vs 1 | RMSE linear | PSNR linear (dB) | RMSE sRGB | PSNR sRGB (dB) | pixels off by > 1/255 |"
+            "| samples | grid | time (s) | time vs 1 | RMSE shaded | PSNR shaded (dB) | RMSE displayed | PSNR displayed (dB) | pixels off by > 1/255 |"
         )?;
         writeln!(md, "|---:|---|---:|---:|---:|---:|---:|---:|---:|")?;
         let mut one = None;
@@ -160,16 +160,16 @@ pub fn run(args: &StudyArgs) -> Result<()> {
             if samples == 1 {
                 t_one = t;
             }
-            let e = image_error(&f.pixels, &reference.pixels);
+            let e = image_error(&f.pixels, &reference.pixels, base.colors);
             let k = (samples as f64).sqrt() as u32;
             writeln!(
                 md,
                 "| {samples} | {k}x{k} | {t:.3} | {:.1}x | {:.4} | {:.1} | {:.4} | {:.1} | {:.1}% |",
                 t / t_one,
-                e.rmse_linear,
-                e.psnr_linear,
-                e.rmse_srgb,
-                e.psnr_srgb,
+                e.rmse_shaded,
+                e.psnr_shaded,
+                e.rmse_display,
+                e.psnr_display,
                 100.0 * e.visible_fraction
             )?;
             if samples == 1 {
@@ -179,7 +179,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
                     let need = args.out.join(format!("{stem}-aa-need.png"));
                     // The same picture as `glint render --view aa-need`, legend included.
                     Frame::aa_need(one, &f).save_png(&need)?;
-                    let e = image_error(&one.pixels, &f.pixels);
+                    let e = image_error(&one.pixels, &f.pixels, base.colors);
                     summary.push((
                         stem.clone(),
                         "1 vs 16 samples: pixels anti-aliasing changes".to_string(),
@@ -207,7 +207,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
         writeln!(md, "### Recursion depth (reference: depth 12, 1 sample)\n")?;
         writeln!(
             md,
-            "| max depth | time (s) | RMSE sRGB | PSNR sRGB (dB) | pixels off by > 1/255 |"
+            "| max depth | time (s) | RMSE displayed | PSNR displayed (dB) | pixels off by > 1/255 |"
         )?;
         writeln!(md, "|---:|---:|---:|---:|---:|")?;
         for depth in 1..=8 {
@@ -219,12 +219,12 @@ pub fn run(args: &StudyArgs) -> Result<()> {
                 },
                 None,
             )?;
-            let e = image_error(&f.pixels, &deep.pixels);
+            let e = image_error(&f.pixels, &deep.pixels, base.colors);
             writeln!(
                 md,
                 "| {depth} | {t:.3} | {:.4} | {:.1} | {:.1}% |",
-                e.rmse_srgb,
-                e.psnr_srgb,
+                e.rmse_display,
+                e.psnr_display,
                 100.0 * e.visible_fraction
             )?;
             if depth == 3 {
@@ -274,7 +274,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
         )?;
         writeln!(
             md,
-            "| resolution | pixels | time to image (s) | RMSE sRGB | PSNR sRGB (dB) | pixels off by > 1/255 |"
+            "| resolution | pixels | time to image (s) | RMSE displayed | PSNR displayed (dB) | pixels off by > 1/255 |"
         )?;
         writeln!(md, "|---|---:|---:|---:|---:|---:|")?;
         let full = one.as_ref().context("1-sample render")?;
@@ -287,21 +287,21 @@ pub fn run(args: &StudyArgs) -> Result<()> {
             };
             let (t, f) = study.run(s, None)?;
             let up = upsample(&f, w, h);
-            let e = image_error(&up, &full.pixels);
+            let e = image_error(&up, &full.pixels, base.colors);
             writeln!(
                 md,
                 "| 1/{d} | {}x{} | {t:.4} | {:.4} | {:.1} | {:.1}% |",
                 s.width,
                 s.height,
-                e.rmse_srgb,
-                e.psnr_srgb,
+                e.rmse_display,
+                e.psnr_display,
                 100.0 * e.visible_fraction
             )?;
             if d == 4 {
                 summary.push((
                     stem.clone(),
-                    "1/4 preview: PSNR sRGB".into(),
-                    format!("{:.1} dB", e.psnr_srgb),
+                    "1/4 preview: PSNR displayed".into(),
+                    format!("{:.1} dB", e.psnr_display),
                 ));
             }
         }

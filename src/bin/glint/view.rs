@@ -7,7 +7,7 @@ use glint::render::ViewMode;
 use glint::viewer::app::CompareSetting;
 use glint::viewer::{GlintApp, SceneSource, ViewerOptions};
 
-use crate::common::{Switch, parse_pixel, parse_size};
+use crate::common::{RulesArgs, Switch, parse_pixel, parse_size};
 
 #[derive(clap::Args)]
 pub struct ViewArgs {
@@ -51,6 +51,8 @@ pub struct ViewArgs {
     /// Show the comparison as |A - B| instead of a split.
     #[arg(long)]
     pub compare_difference: bool,
+    #[command(flatten)]
+    pub rules: RulesArgs,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -76,6 +78,7 @@ impl Default for ViewArgs {
             inspect: None,
             compare: None,
             compare_difference: false,
+            rules: RulesArgs::default(),
         }
     }
 }
@@ -107,6 +110,9 @@ pub fn run(args: &ViewArgs) -> Result<()> {
             CompareArg::Aa => CompareSetting::AntiAliasing,
         }),
         compare_difference: args.compare_difference,
+        protocol: args.rules.protocol,
+        colors: args.rules.colors,
+        sides: args.rules.sides,
     };
     let native = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()

@@ -1,0 +1,134 @@
+//! What the numbers of a scene's colours mean, and how a shaded value
+//! becomes a pixel.
+//!
+//! glint's own scenes give colours in linear light: shading adds light
+//! there, and the picture is encoded with the sRGB transfer function
+//! (IEC 61966-2-1) at the end. The SPD's NFF scenes, and the pictures
+//! published with them, treat colours as display values: shaded as they
+//! are and written with no transfer function. Either convention can be
+//! chosen for any scene; each format has its default.
+
+use crate::math::{Color, DVec3};
+
+/// How colours are shaded and written.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ColorConvention {
+    /// Shade in linear light, write sRGB-encoded (glint's TOML scenes).
+    #[default]
+    Linear,
+    /// Shade display values as they are, write them unchanged (the SPD's
+    /// convention, the default for NFF scenes).
+    Display,
+}
+
+impl ColorConvention {
+    pub const ALL: [ColorConvention; 2] = [ColorConvention::Linear, ColorConvention::Display];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ColorConvention::Linear => "linear",
+            ColorConvention::Display => "display",
+        }
+    }
+
+    /// A shaded value as it is displayed, in `[0, 1]`.
+    #[inline]
+    pub fn encode(self, x: f64) -> f64 {
+        match self {
+            ColorConvention::Linear => linear_to_srgb(x),
+            ColorConvention::Display => x.clamp(0.0, 1.0),
+        }
+    }
+
+    /// [`ColorConvention::encode`] of each channel.
+    #[inline]
+    pub fn encode_rgb(self, c: Color) -> DVec3 {
+        DVec3::new(self.encode(c.x), self.encode(c.y), self.encode(c.z))
+    }
+
+    /// The colour a scene file's value `c` shades as, when the file gives
+    /// colours in `file` terms and the render uses `self`: display values
+    /// are decoded into linear light for a linear render; nothing else
+    /// changes (a display render shades the file's numbers as they are).
+    pub fn shading_color(self, file: ColorConvention, c: Color) -> Color {
+        match (file, self) {
+            (ColorConvention::Display, ColorConvention::Linear) => DVec3::new(
+                srgb_to_linear(c.x),
+                srgb_to_linear(c.y),
+                srgb_to_linear(c.z),
+            ),
+            _ => c,
+        }
+    }
+}
+
+impl std::str::FromStr for ColorConvention {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|c| c.name() == s)
+            .ok_or_else(|| format!("unknown colour convention `{s}` (expected linear or display)"))
+    }
+}
+
+/// sRGB transfer function (IEC 61966-2-1) of a linear value in `[0, 1]`.
+pub fn linear_to_srgb(x: f64) -> f64 {
+    let x = x.clamp(0.0, 1.0);
+    if x <= 0.003_130_8 {
+        12.92 * x
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// Inverse of [`linear_to_srgb`] on `[0, 1]`.
+pub fn srgb_to_linear(x: f64) -> f64 {
+    let x = x.clamp(0.0, 1.0);
+    if x <= 0.040_45 {
+        x / 12.92
+    } else {
+        ((x + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// A display value in `[0, 1]` as an 8-bit channel.
+#[inline]
+pub fn to_byte(x: f64) -> u8 {
+    (x.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn srgb_round_trips_and_hits_known_values() {
+        for k in 0..=100 {
+            let x = k as f64 / 100.0;
+            assert!((srgb_to_linear(linear_to_srgb(x)) - x).abs() < 1e-12);
+        }
+        // 18% grey is about 46% in sRGB; sRGB 0.5 is 21.4% linear.
+        assert!((linear_to_srgb(0.18) - 0.4614).abs() < 1e-3);
+        assert!((srgb_to_linear(0.5) - 0.2140).abs() < 1e-3);
+    }
+
+    #[test]
+    fn display_convention_writes_values_unchanged() {
+        let c = DVec3::new(0.25, 0.5, 1.5);
+        assert_eq!(
+            ColorConvention::Display.encode_rgb(c),
+            DVec3::new(0.25, 0.5, 1.0)
+        );
+        let file = ColorConvention::Display;
+        assert_eq!(ColorConvention::Display.shading_color(file, c), c);
+        let linear = ColorConvention::Linear.shading_color(file, DVec3::splat(0.5));
+        assert!((linear.x - 0.2140).abs() < 1e-3);
+        // Linear files shade as given under either convention.
+        assert_eq!(
+            ColorConvention::Display.shading_color(ColorConvention::Linear, c),
+            c
+        );
+    }
+}
