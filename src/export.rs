@@ -114,7 +114,7 @@ impl RenderRecord {
             glint_version: env!("CARGO_PKG_VERSION").to_string(),
             scene_path: scene_path.to_string(),
             scene_sha256: crate::sha256::sha256_hex(scene.source_text.as_bytes()),
-            scene_text: scene.source_text.clone(),
+            scene_text: scene.source_text.to_string(),
             settings: RecordedSettings {
                 camera: camera.into(),
                 render: settings,

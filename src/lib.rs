@@ -14,6 +14,7 @@
 #![forbid(unsafe_code)]
 
 pub mod accel;
+pub mod adaptive;
 pub mod camera;
 pub mod color;
 pub mod export;

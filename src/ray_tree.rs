@@ -104,6 +104,12 @@ pub trait RayRecorder: Sized {
     fn hit(&mut self, _record: impl FnOnce() -> HitRecord) {}
     #[inline(always)]
     fn shadow(&mut self, _record: impl FnOnce() -> ShadowRecord) {}
+    /// The material of the surface hit (cheap, for the adaptive sampler).
+    #[inline(always)]
+    fn material(&mut self, _index: u32) {}
+    /// Whether light `index` reaches the hit point.
+    #[inline(always)]
+    fn light(&mut self, _index: usize, _lit: bool) {}
     #[inline(always)]
     fn local(&mut self, _color: Color) {}
     #[inline(always)]

@@ -4,7 +4,10 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use rayon::prelude::*;
 
-use crate::accel::{ClosestHit, Octree, Primitives, closest_brute_force, occlusion_brute_force};
+use crate::accel::{
+    ClosestHit, Octree, Primitives, ShadowCrossings, closest_brute_force, occlusion_brute_force,
+};
+use crate::adaptive::{Signature, refine_mask};
 use crate::camera::{Camera, CameraError, CameraSpec, sample_offsets};
 pub use crate::color::linear_to_srgb;
 use crate::color::{ColorConvention, to_byte};
@@ -12,7 +15,7 @@ use crate::material::Material;
 use crate::math::{Color, DVec3, Ray, offset_ray_origin, reflect, refract};
 use crate::ray_tree::{HitRecord, NoRecord, RayKind, RayNode, RayRecorder, ShadowRecord};
 use crate::scene::Scene;
-pub use crate::settings::{Protocol, RenderSettings, Sides, ViewMode};
+pub use crate::settings::{AntiAliasing, Protocol, RenderSettings, Sides, ViewMode};
 use crate::shapes::PreparedRay;
 use crate::stats::{Counter, NoCounts, RayCounts, WorkCounts};
 
@@ -83,14 +86,24 @@ pub struct TileCounts {
     /// Samples whose colour came out NaN or infinite (then shown black).
     /// Always zero unless something is wrong: tests assert it.
     pub nonfinite_samples: u64,
+    /// Pixels adaptive anti-aliasing refined with the full grid.
+    pub refined_pixels: u64,
 }
 
 impl std::ops::AddAssign for TileCounts {
     fn add_assign(&mut self, o: Self) {
+        self.refined_pixels += o.refined_pixels;
         self.rays += o.rays;
         self.work += o.work;
         self.nonfinite_samples += o.nonfinite_samples;
     }
+}
+
+thread_local! {
+    /// A shadow ray's crossings, kept per thread: the array is set up once,
+    /// not for every ray.
+    static SHADOW_CROSSINGS: std::cell::RefCell<ShadowCrossings> =
+        std::cell::RefCell::new(ShadowCrossings::default());
 }
 
 /// Crossings of one material closer than this, relative to the scene's
@@ -220,12 +233,19 @@ impl<'a> Renderer<'a> {
     /// through a mesh's shared edge, two glass bodies touching: no
     /// interface), and any opaque surface blocks the light.
     fn transmittance<C: Counter>(&self, ray: &PreparedRay, distance: f64, counter: &mut C) -> f64 {
-        let prims = self.primitives();
-        let found = if self.settings.use_octree {
-            self.octree.occlusion(&prims, ray, distance, counter)
-        } else {
-            occlusion_brute_force(&prims, ray, distance, counter)
-        };
+        SHADOW_CROSSINGS.with_borrow_mut(|found| {
+            let prims = self.primitives();
+            if self.settings.use_octree {
+                self.octree.occlusion(&prims, ray, distance, found, counter);
+            } else {
+                occlusion_brute_force(&prims, ray, distance, found, counter);
+            }
+            self.pass_through(found)
+        })
+    }
+
+    /// The light a shadow ray's crossings let through.
+    fn pass_through(&self, found: &ShadowCrossings) -> f64 {
         if found.is_blocked() {
             return 0.0;
         }
@@ -285,6 +305,7 @@ impl<'a> Renderer<'a> {
         }
         let view = -ray.dir;
         let p = surface.point;
+        rec.material(scene.shape_materials[hit.shape as usize]);
         rec.hit(|| HitRecord {
             object: hit.shape,
             kind: shape.kind_name(),
@@ -307,6 +328,7 @@ impl<'a> Renderer<'a> {
             let to_light = light.position - shadow_origin;
             let distance = to_light.length();
             if !(distance > 0.0) {
+                rec.light(index, false);
                 rec.shadow(|| verdict("faces-away", 0.0, Color::ZERO));
                 continue;
             }
@@ -322,12 +344,14 @@ impl<'a> Renderer<'a> {
                 Protocol::Spd => n_dot_l <= 0.0,
             };
             if faces_away {
+                rec.light(index, false);
                 rec.shadow(|| verdict("faces-away", 0.0, Color::ZERO));
                 continue;
             }
             rays.shadow += 1;
             let shadow = PreparedRay::new(Ray::new(shadow_origin, l));
             let pass = self.transmittance(&shadow, distance, counter);
+            rec.light(index, pass > 0.0);
             if pass == 0.0 {
                 rec.shadow(|| verdict("blocked", 0.0, Color::ZERO));
                 continue;
@@ -442,12 +466,23 @@ impl<'a> Renderer<'a> {
     /// or work), with its rays and work counted; non-finite values are
     /// counted and shown black.
     fn sample<C: Counter>(&self, ray: &Ray, counter: &mut C, counts: &mut TileCounts) -> DVec3 {
+        self.sample_recorded(ray, counter, counts, &mut NoRecord)
+    }
+
+    /// [`Renderer::sample`], telling `rec` what the ray met.
+    fn sample_recorded<C: Counter, R: RayRecorder>(
+        &self,
+        ray: &Ray,
+        counter: &mut C,
+        counts: &mut TileCounts,
+        rec: &mut R,
+    ) -> DVec3 {
         counts.rays.primary += 1;
         let view = self.settings.view;
         let value = if view.is_cost() {
             // Count this ray's work on its own, then pass it on.
             let mut work = WorkCounts::default();
-            self.trace(ray, 1, &mut work, &mut counts.rays, &mut NoRecord);
+            self.trace(ray, 1, &mut work, &mut counts.rays, rec);
             counter.add_work(&work);
             DVec3::new(
                 work.intersection_tests as f64,
@@ -455,7 +490,7 @@ impl<'a> Renderer<'a> {
                 work.leaves_visited as f64,
             )
         } else if view.traces_shading() {
-            self.trace(ray, 1, counter, &mut counts.rays, &mut NoRecord)
+            self.trace(ray, 1, counter, &mut counts.rays, rec)
         } else {
             self.inspect(ray, counter, &mut counts.rays)
         };
@@ -467,26 +502,6 @@ impl<'a> Renderer<'a> {
         }
     }
 
-    /// A pixel's value from its samples: their mean; for the depth view the
-    /// mean distance of those that hit and the share that hit; for the cost
-    /// views their sum (`cost_sum`) or mean.
-    fn combine(&self, samples: &[DVec3], cost_sum: bool) -> DVec3 {
-        let n = samples.len().max(1) as f64;
-        match self.settings.view {
-            ViewMode::Depth => {
-                let hits: f64 = samples.iter().map(|v| v.y).sum();
-                if hits > 0.0 {
-                    let distance: f64 = samples.iter().map(|v| v.x).sum();
-                    DVec3::new(distance / hits, hits / n, 0.0)
-                } else {
-                    DVec3::ZERO
-                }
-            }
-            ViewMode::Cost | ViewMode::CostSteps if cost_sum => samples.iter().sum(),
-            _ => samples.iter().sum::<DVec3>() / n,
-        }
-    }
-
     /// Value of pixel `(i, j)` from its grid of samples.
     pub fn pixel<C: Counter>(
         &self,
@@ -495,12 +510,121 @@ impl<'a> Renderer<'a> {
         counter: &mut C,
         counts: &mut TileCounts,
     ) -> DVec3 {
-        let mut samples = [DVec3::ZERO; 256];
-        let n = self.offsets.len();
-        for (k, &(dx, dy)) in self.offsets.iter().enumerate() {
-            samples[k] = self.sample(&self.camera.ray(i, j, dx, dy), counter, counts);
+        let mut pixel = PixelSum::default();
+        for &(dx, dy) in &self.offsets {
+            pixel.add(self.sample(&self.camera.ray(i, j, dx, dy), counter, counts));
         }
-        self.combine(&samples[..n], true)
+        pixel.value(self.settings.view, true)
+    }
+
+    /// Adaptive anti-aliasing's first pass over a tile: each pixel's centre
+    /// sample and the signature of what it met.
+    pub fn first_pass_tile(
+        &self,
+        tile: Tile,
+        count_work: bool,
+    ) -> (Vec<DVec3>, Vec<u64>, TileCounts) {
+        let mut counts = TileCounts::default();
+        let mut work = WorkCounts::default();
+        let n = (tile.width * tile.height) as usize;
+        let (mut values, mut signatures) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        for j in tile.y..tile.y + tile.height {
+            for i in tile.x..tile.x + tile.width {
+                let ray = self.camera.ray(i, j, 0.5, 0.5);
+                let mut signature = Signature::default();
+                let mut pixel = PixelSum::default();
+                let value = if count_work {
+                    self.sample_recorded(&ray, &mut work, &mut counts, &mut signature)
+                } else {
+                    self.sample_recorded(&ray, &mut NoCounts, &mut counts, &mut signature)
+                };
+                pixel.add(value);
+                values.push(pixel.value(self.settings.view, true));
+                signatures.push(signature.value);
+            }
+        }
+        counts.work = work;
+        (values, signatures, counts)
+    }
+
+    /// Adaptive anti-aliasing's second pass over a tile: the full grid for
+    /// the pixels `mask` marks (frame-sized, row-major), the first pass's
+    /// value (`first`, frame-sized) for the others.
+    pub fn refine_tile(
+        &self,
+        tile: Tile,
+        first: &[DVec3],
+        mask: &[bool],
+        count_work: bool,
+    ) -> (Vec<DVec3>, TileCounts) {
+        let mut counts = TileCounts::default();
+        let mut work = WorkCounts::default();
+        let mut out = Vec::with_capacity((tile.width * tile.height) as usize);
+        let w = self.settings.width;
+        for j in tile.y..tile.y + tile.height {
+            for i in tile.x..tile.x + tile.width {
+                let at = (j * w + i) as usize;
+                if !mask[at] {
+                    out.push(first[at]);
+                    continue;
+                }
+                counts.refined_pixels += 1;
+                out.push(if count_work {
+                    self.pixel(i, j, &mut work, &mut counts)
+                } else {
+                    self.pixel(i, j, &mut NoCounts, &mut counts)
+                });
+            }
+        }
+        counts.work = work;
+        (out, counts)
+    }
+
+    /// Both passes of adaptive anti-aliasing over the whole frame.
+    fn render_adaptive(
+        &self,
+        count_work: bool,
+        progress: Option<&(dyn Fn(u64, u64) + Sync)>,
+    ) -> (Frame, TileCounts) {
+        let (w, h) = (self.settings.width, self.settings.height);
+        let all = tiles(w, h);
+        let total = 2 * all.len() as u64;
+        let done = AtomicU64::new(0);
+        let tick = || {
+            let n = done.fetch_add(1, Ordering::Relaxed) + 1;
+            if let Some(p) = progress {
+                p(n, total);
+            }
+        };
+        let first: Vec<(Vec<DVec3>, Vec<u64>, TileCounts)> = all
+            .par_iter()
+            .map(|&t| {
+                let r = self.first_pass_tile(t, count_work);
+                tick();
+                r
+            })
+            .collect();
+        let mut signatures = vec![0u64; (w * h) as usize];
+        for (tile, (_, sig, _)) in all.iter().zip(&first) {
+            place_tile(&mut signatures, w, tile, sig);
+        }
+        let (first_frame, mut counts) = assemble_tiles(
+            &self.settings,
+            &all,
+            first.into_iter().map(|(values, _, c)| (values, c)),
+        );
+        let mask = refine_mask(&first_frame.to_rgb8(), &signatures, w, h);
+        let second: Vec<(Vec<DVec3>, TileCounts)> = all
+            .par_iter()
+            .map(|&t| {
+                let r = self.refine_tile(t, &first_frame.pixels, &mask, count_work);
+                tick();
+                r
+            })
+            .collect();
+        let (frame, more) = assemble_tiles(&self.settings, &all, second);
+        counts += more;
+        (frame, counts)
     }
 
     /// Renders one tile into a row-major buffer of `tile.width * tile.height`.
@@ -576,8 +700,11 @@ impl<'a> Renderer<'a> {
         let mut out = Vec::with_capacity((width * height) as usize);
         for j in 0..height {
             for i in 0..width {
-                let at = |di: u32, dj: u32| corners[((j + dj) * stride + i + di) as usize];
-                out.push(self.combine(&[at(0, 0), at(1, 0), at(0, 1), at(1, 1)], false));
+                let mut pixel = PixelSum::default();
+                for (di, dj) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                    pixel.add(corners[((j + dj) * stride + i + di) as usize]);
+                }
+                out.push(pixel.value(self.settings.view, false));
             }
         }
         out
@@ -667,6 +794,9 @@ impl<'a> Renderer<'a> {
         if self.settings.corner_rays() {
             return self.render_corners(count_work, progress);
         }
+        if self.settings.anti_aliasing() == AntiAliasing::Adaptive {
+            return self.render_adaptive(count_work, progress);
+        }
         let (w, h) = (self.settings.width, self.settings.height);
         let all = tiles(w, h);
         let total = all.len() as u64;
@@ -686,6 +816,47 @@ impl<'a> Renderer<'a> {
     }
 }
 
+/// A pixel's samples as they arrive: their sum, and for the depth view the
+/// distances of those that hit and their number.
+#[derive(Clone, Copy, Default)]
+struct PixelSum {
+    sum: DVec3,
+    n: u32,
+}
+
+impl PixelSum {
+    #[inline]
+    fn add(&mut self, sample: DVec3) {
+        self.sum += sample;
+        self.n += 1;
+    }
+
+    /// The pixel: the samples' mean; for the depth view the mean distance
+    /// of those that hit (`x` sums distances, `y` hits) and the share that
+    /// hit; for the cost views their sum (`cost_sum`) or mean.
+    fn value(&self, view: ViewMode, cost_sum: bool) -> DVec3 {
+        let n = self.n.max(1) as f64;
+        match view {
+            ViewMode::Depth if self.sum.y > 0.0 => {
+                DVec3::new(self.sum.x / self.sum.y, self.sum.y / n, 0.0)
+            }
+            ViewMode::Depth => DVec3::ZERO,
+            ViewMode::Cost | ViewMode::CostSteps if cost_sum => self.sum,
+            _ => self.sum / n,
+        }
+    }
+}
+
+/// Copies a tile's row-major values into a frame-sized buffer.
+pub fn place_tile<T: Copy>(frame: &mut [T], width: u32, tile: &Tile, values: &[T]) {
+    for row in 0..tile.height {
+        let start = ((tile.y + row) * width + tile.x) as usize;
+        let src = (row * tile.width) as usize;
+        frame[start..start + tile.width as usize]
+            .copy_from_slice(&values[src..src + tile.width as usize]);
+    }
+}
+
 /// Puts rendered tiles together into a frame, summing their counts in tile
 /// order (so totals never depend on the thread schedule).
 pub fn assemble_tiles(
@@ -698,12 +869,7 @@ pub fn assemble_tiles(
     let mut counts = TileCounts::default();
     for (tile, (values, c)) in tiles.iter().zip(results) {
         counts += c;
-        for row in 0..tile.height {
-            let start = ((tile.y + row) * width + tile.x) as usize;
-            let src = (row * tile.width) as usize;
-            pixels[start..start + tile.width as usize]
-                .copy_from_slice(&values[src..src + tile.width as usize]);
-        }
+        place_tile(&mut pixels, width, tile, &values);
     }
     let frame = Frame {
         width,
@@ -857,39 +1023,29 @@ impl Frame {
     /// colour convention (sRGB for linear light), normals raw, depth
     /// normalised to the visible range.
     pub fn to_rgb8(&self) -> Vec<u8> {
-        let mut out = Vec::with_capacity(self.pixels.len() * 3);
-        match self.view {
-            ViewMode::Shaded => {
-                for p in &self.pixels {
-                    out.extend([p.x, p.y, p.z].map(|c| to_byte(self.colors.encode(c))));
+        // Frame-wide values first, then every pixel on its own, in parallel
+        // (the sRGB encoding of an 800x600 frame is 1.4 million powers).
+        let near = (self.view == ViewMode::Depth).then(|| nearest_depth(&self.pixels));
+        let range = self.cost_summary().map_or((0.0, 0.0), |c| (c.min, c.max));
+        let encode = |p: &DVec3| -> [u8; 3] {
+            match self.view {
+                ViewMode::Shaded => [p.x, p.y, p.z].map(|c| to_byte(self.colors.encode(c))),
+                ViewMode::Normals => [p.x, p.y, p.z].map(to_byte),
+                ViewMode::Depth => [to_byte(depth_shade(*p, near.unwrap_or(0.0))); 3],
+                ViewMode::Cost | ViewMode::CostSteps => {
+                    crate::legend::viridis(cost_shade(cost_value(*p, self.view), range))
                 }
+                ViewMode::AaNeed => [p.x, p.y, p.z].map(|c| to_byte(c * AA_NEED_GAIN)),
             }
-            ViewMode::Normals => {
-                for p in &self.pixels {
-                    out.extend([p.x, p.y, p.z].map(to_byte));
+        };
+        let mut out = vec![0u8; self.pixels.len() * 3];
+        out.par_chunks_mut(3 * 4096)
+            .zip(self.pixels.par_chunks(4096))
+            .for_each(|(bytes, pixels)| {
+                for (b, p) in bytes.chunks_exact_mut(3).zip(pixels) {
+                    b.copy_from_slice(&encode(p));
                 }
-            }
-            ViewMode::Depth => {
-                let near = nearest_depth(&self.pixels);
-                for p in &self.pixels {
-                    out.extend([to_byte(depth_shade(*p, near)); 3]);
-                }
-            }
-            ViewMode::Cost | ViewMode::CostSteps => {
-                let range = self.cost_summary().map_or((0.0, 0.0), |c| (c.min, c.max));
-                for p in &self.pixels {
-                    out.extend(crate::legend::viridis(cost_shade(
-                        cost_value(*p, self.view),
-                        range,
-                    )));
-                }
-            }
-            ViewMode::AaNeed => {
-                for p in &self.pixels {
-                    out.extend([p.x, p.y, p.z].map(|c| to_byte(c * AA_NEED_GAIN)));
-                }
-            }
-        }
+            });
         out
     }
 

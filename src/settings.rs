@@ -126,6 +126,45 @@ impl std::str::FromStr for Protocol {
     }
 }
 
+/// Anti-aliasing, as the command line, the viewer and scene files name it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum AntiAliasing {
+    /// One ray through each pixel's centre.
+    #[default]
+    Off,
+    /// The centre everywhere, the 4x4 grid where neighbours differ.
+    Adaptive,
+    /// The regular 4x4 grid in every pixel.
+    Full,
+}
+
+impl AntiAliasing {
+    pub const ALL: [AntiAliasing; 3] = [
+        AntiAliasing::Off,
+        AntiAliasing::Adaptive,
+        AntiAliasing::Full,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            AntiAliasing::Off => "off",
+            AntiAliasing::Adaptive => "adaptive",
+            AntiAliasing::Full => "full",
+        }
+    }
+}
+
+impl std::str::FromStr for AntiAliasing {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|a| a.name() == s)
+            .ok_or_else(|| format!("unknown anti-aliasing `{s}` (expected off, adaptive or full)"))
+    }
+}
+
 /// Everything that decides the image besides the scene; the command line
 /// and the viewer override the scene's own values.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -146,6 +185,10 @@ pub struct RenderSettings {
     pub colors: ColorConvention,
     #[serde(default)]
     pub sides: Sides,
+    /// With `samples > 1`: trace every pixel's centre, then the full grid
+    /// only where the picture shows an edge (see [`crate::adaptive`]).
+    #[serde(default)]
+    pub adaptive: bool,
 }
 
 impl RenderSettings {
@@ -160,7 +203,27 @@ impl RenderSettings {
             protocol: Protocol::Glint,
             colors: scene.image.colors,
             sides: scene.image.sides,
+            adaptive: scene.image.adaptive,
         }
+    }
+
+    /// The anti-aliasing these settings ask for.
+    pub fn anti_aliasing(&self) -> AntiAliasing {
+        match (self.samples, self.adaptive) {
+            (1, _) => AntiAliasing::Off,
+            (_, true) => AntiAliasing::Adaptive,
+            _ => AntiAliasing::Full,
+        }
+    }
+
+    /// Sets the anti-aliasing: off is 1 sample, full the 4x4 grid, adaptive
+    /// the 4x4 grid where the picture needs it.
+    pub fn set_anti_aliasing(&mut self, aa: AntiAliasing) {
+        (self.samples, self.adaptive) = match aa {
+            AntiAliasing::Off => (1, false),
+            AntiAliasing::Adaptive => (16, true),
+            AntiAliasing::Full => (16, false),
+        };
     }
 
     /// Switches to `protocol`, taking the depth and sidedness it prescribes.

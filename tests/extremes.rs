@@ -21,7 +21,7 @@ fn transformed(scene: &Scene, s: f64, t: DVec3) -> Scene {
     for l in &mut out.lights {
         l.position = map(l.position);
     }
-    for shape in &mut out.shapes {
+    for shape in std::sync::Arc::make_mut(&mut out.shapes).iter_mut() {
         *shape = match shape.clone() {
             Shape::Sphere(sp) => Shape::Sphere(Sphere::new(map(sp.center), s * sp.radius)),
             Shape::Plane(p) => Shape::Plane(glint::shapes::Plane::new(map(p.point), p.normal)),

@@ -4,7 +4,9 @@
 mod common;
 
 use common::{all_scenes, load, render_with};
-use glint::accel::{Octree, OctreeParams, Primitives, closest_brute_force, occlusion_brute_force};
+use glint::accel::{
+    Octree, OctreeParams, Primitives, ShadowCrossings, closest_brute_force, occlusion_brute_force,
+};
 use glint::math::{DVec3, Ray};
 use glint::shapes::{PreparedRay, Shape, Sphere, Triangle};
 use glint::stats::NoCounts;
@@ -92,8 +94,11 @@ proptest! {
             let brute = closest_brute_force(&prims, &prepared, f64::INFINITY, &mut NoCounts);
             let tree = octree.closest(&prims, &prepared, f64::INFINITY, &mut NoCounts);
             prop_assert_eq!(brute, tree, "closest hit differs for {:?}", ray);
-            let b = occlusion_brute_force(&prims, &prepared, shadow_length, &mut NoCounts);
-            let t = octree.occlusion(&prims, &prepared, shadow_length, &mut NoCounts);
+            let mut b = ShadowCrossings::default();
+            occlusion_brute_force(&prims, &prepared, shadow_length, &mut b, &mut NoCounts);
+            // Left over from another ray: cleared by the query.
+            let mut t = b.clone();
+            octree.occlusion(&prims, &prepared, shadow_length, &mut t, &mut NoCounts);
             prop_assert_eq!(b, t, "shadow verdict differs for {:?}", ray);
         }
     }

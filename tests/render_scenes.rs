@@ -124,7 +124,7 @@ fn quadric_sphere_renders_like_the_analytic_sphere() {
     else {
         panic!("the first object of sphere.toml is the sphere");
     };
-    scene.shapes[0] = Shape::Quadric(Box::new(Quadric::new(
+    std::sync::Arc::make_mut(&mut scene.shapes)[0] = Shape::Quadric(Box::new(Quadric::new(
         [
             1.0,
             0.0,

@@ -572,7 +572,7 @@ fn records_of_large_scenes_keep_standard_text_chunks_small() {
     }
     // The scene is still all there, for --from-png and glint info.
     let read = glint::export::read_record(&png).unwrap();
-    assert_eq!(read.scene_text, scene.source_text);
+    assert_eq!(read.scene_text, &*scene.source_text);
     assert_eq!(read, record);
     // And a reader that does not know glint still decodes the image.
     assert_eq!(image::open(&png).unwrap().to_rgb8().dimensions(), (8, 8));

@@ -74,9 +74,16 @@ fn display_only_frames_do_not_restart() {
 fn editing_a_light_restarts() {
     let mut h = harness(small_app());
     let generation = h.state().worker().generation();
+    let shapes = Arc::clone(&h.state().scene().shapes);
     h.state_mut().scene_mut().lights[0].position.x += 1.0;
     h.run_steps(2);
     assert!(h.state().worker().generation() > generation);
+    // The worker still holds the old scene: the edit copied the look, not
+    // the geometry.
+    assert!(
+        Arc::ptr_eq(&shapes, &h.state().scene().shapes),
+        "geometry copied"
+    );
 }
 
 #[test]
@@ -438,5 +445,35 @@ fn protocol_spd_in_the_viewer_is_one_corner_pass_equal_to_the_cli() {
     assert!(
         shown == cli,
         "the corner pass equals `glint render --protocol spd`"
+    );
+}
+
+#[test]
+fn adaptive_refinement_pass_equals_the_cli_adaptive_render() {
+    let worker = Worker::spawn(2, || {});
+    let (mut job, scene, octree) = job("scenes/default.toml", 120, 90, true);
+    job.settings.adaptive = true;
+    let settings = job.settings;
+    let generation = worker.submit(job);
+    assert!(worker.wait_finished(generation, WAIT));
+    let last = worker.history().last().copied().unwrap();
+    assert_eq!(last.kind, PassKind::SixteenSamples);
+    let refined = last.refined_pixels.expect("an adaptive pass");
+    assert!(refined > 0 && refined < 120 * 90);
+    let mut cli_settings = settings;
+    cli_settings.set_anti_aliasing(glint::render::AntiAliasing::Adaptive);
+    let (frame, counts) = Renderer::new(&scene, &octree, cli_settings)
+        .unwrap()
+        .render(false, None);
+    assert_eq!(counts.refined_pixels, refined);
+    let shown: Vec<u8> = worker.with_buffer(|b| {
+        b.rgba
+            .chunks_exact(4)
+            .flat_map(|p| [p[0], p[1], p[2]])
+            .collect()
+    });
+    assert!(
+        shown == frame.to_rgb8(),
+        "the viewer's adaptive pass equals `glint render --aa adaptive`"
     );
 }

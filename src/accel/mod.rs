@@ -160,6 +160,12 @@ impl std::fmt::Debug for ShadowCrossings {
 }
 
 impl ShadowCrossings {
+    /// Empties it for the next shadow ray (without touching the array).
+    pub fn clear(&mut self) {
+        self.blocked = false;
+        self.len = 0;
+    }
+
     pub fn is_blocked(&self) -> bool {
         self.blocked
     }
@@ -222,20 +228,21 @@ pub(crate) fn test_occlusion<C: Counter>(
     false
 }
 
-/// Everything in `(0, t_max)`, testing every shape; stops at the first opaque one.
+/// Everything in `(0, t_max)` into `found` (cleared first), testing every
+/// shape; stops at the first opaque one.
 pub fn occlusion_brute_force<C: Counter>(
     prims: &Primitives,
     ray: &PreparedRay,
     t_max: f64,
+    found: &mut ShadowCrossings,
     counter: &mut C,
-) -> ShadowCrossings {
-    let mut found = ShadowCrossings::default();
+) {
+    found.clear();
     for i in 0..prims.shapes.len() as u32 {
-        if test_occlusion(prims, i, ray, t_max, &mut found, counter) {
+        if test_occlusion(prims, i, ray, t_max, found, counter) {
             break;
         }
     }
-    found
 }
 
 #[cfg(test)]

@@ -20,8 +20,10 @@
 //! Lastra, "An Efficient Parametric Algorithm for Octree Traversal" (WSCG
 //! 2000): from the parameters at which the ray crosses a node's three
 //! mid-planes follows the sequence of children it passes through, without
-//! any point-in-box test. Rays stop as soon as the best hit lies before the
-//! exit of the current leaf.
+//! any point-in-box test. It runs iteratively on a small stack kept per
+//! thread (no allocation, no recursion); a node stores a mask of its
+//! non-empty children, which alone are stored and visited. Rays stop as
+//! soon as the best hit lies before the exit of the current leaf.
 
 use rayon::prelude::*;
 
@@ -60,8 +62,9 @@ pub const DEFAULT_MAX_DUPLICATION: u32 = 8;
 /// build finishes in seconds even when a scene would use it all.
 pub const DEFAULT_MEMORY_BUDGET_MIB: u32 = 128;
 
-/// Largest budget glint accepts: references are 32-bit indices.
-pub const MAX_MEMORY_BUDGET_MIB: u32 = 8192;
+/// Largest budget glint accepts: references are 31-bit counts and 32-bit
+/// indices.
+pub const MAX_MEMORY_BUDGET_MIB: u32 = 4096;
 
 fn default_max_duplication() -> u32 {
     DEFAULT_MAX_DUPLICATION
@@ -135,16 +138,78 @@ pub struct OctreeCell {
     pub references: u64,
 }
 
-/// Leaf: `refs[first .. first + count]`. Interior: eight children stored
-/// consecutively from `first`, octant bit 0 = upper x, bit 1 = upper y,
-/// bit 2 = upper z. 8 bytes, so a cache line holds a node's eight children.
+/// Leaf: `refs[first .. first + count]`. Interior: a mask of the octants
+/// holding anything (octant bit 0 = upper x, bit 1 = upper y, bit 2 =
+/// upper z), whose nodes alone are stored, consecutively from `first` in
+/// octant order: empty octants cost neither memory nor a load. 8 bytes.
 #[derive(Clone, Copy, Debug)]
 struct Node {
     first: u32,
-    count: u32,
+    /// Leaf: the reference count. Interior: [`INTERIOR`] | the octant mask.
+    meta: u32,
 }
 
-const INTERIOR: u32 = u32::MAX;
+const INTERIOR: u32 = 1 << 31;
+
+impl Node {
+    const EMPTY: Node = Node { first: 0, meta: 0 };
+
+    #[inline(always)]
+    fn is_leaf(self) -> bool {
+        self.meta & INTERIOR == 0
+    }
+
+    #[inline(always)]
+    fn count(self) -> u32 {
+        self.meta
+    }
+
+    #[inline(always)]
+    fn mask(self) -> u32 {
+        self.meta & 0xff
+    }
+
+    /// Index of the node of octant `c`, which must be in the mask.
+    #[inline(always)]
+    fn child(self, c: usize) -> u32 {
+        self.first + (self.mask() & ((1 << c) - 1)).count_ones()
+    }
+}
+
+/// A cubic cell: its lowest corner and side. Children are formed by the
+/// same arithmetic in the build and the traversal, so their cells agree to
+/// the bit.
+#[derive(Clone, Copy, Debug, Default)]
+struct Cell {
+    min: DVec3,
+    side: f64,
+}
+
+impl Cell {
+    #[inline(always)]
+    fn half(&self) -> f64 {
+        0.5 * self.side
+    }
+
+    #[inline(always)]
+    fn mid(&self) -> DVec3 {
+        self.min + DVec3::splat(self.half())
+    }
+
+    #[inline(always)]
+    fn child(&self, c: usize) -> Cell {
+        let h = self.half();
+        let pick = |k: usize| if c >> k & 1 == 1 { h } else { 0.0 };
+        Cell {
+            min: self.min + DVec3::new(pick(0), pick(1), pick(2)),
+            side: h,
+        }
+    }
+
+    fn aabb(&self) -> Aabb {
+        Aabb::new(self.min, self.min + DVec3::splat(self.side))
+    }
+}
 
 #[derive(Clone, Debug)]
 pub struct Octree {
@@ -168,28 +233,6 @@ const PARALLEL_MIN: usize = 2048;
 /// Nodes of a level are classified in batches of about this many
 /// references, so a level's candidate children never all exist at once.
 const BATCH_REFERENCES: usize = 1 << 20;
-
-/// The box of octant `child` of `[min, max]`, split at its centre. Build and
-/// traversal both use this, so their cells are bit-identical.
-#[inline(always)]
-fn octant(min: DVec3, max: DVec3, mid: DVec3, child: usize) -> (DVec3, DVec3) {
-    let pick = |k: usize, lo: f64, m: f64, hi: f64| {
-        if child >> k & 1 == 1 {
-            (m, hi)
-        } else {
-            (lo, m)
-        }
-    };
-    let (x0, x1) = pick(0, min.x, mid.x, max.x);
-    let (y0, y1) = pick(1, min.y, mid.y, max.y);
-    let (z0, z1) = pick(2, min.z, mid.z, max.z);
-    (DVec3::new(x0, y0, z0), DVec3::new(x1, y1, z1))
-}
-
-#[inline(always)]
-fn centre(min: DVec3, max: DVec3) -> DVec3 {
-    0.5 * (min + max)
-}
 
 impl Octree {
     /// Builds the octree over the bounded shapes (unbounded ones are kept
@@ -227,7 +270,12 @@ impl Octree {
         // would be crossed by the dozen). Padded so shapes on its faces lie inside.
         let half = DVec3::splat(0.5 * bounds.extent().max_element());
         let c = bounds.center();
-        tree.bounds = Aabb::new(c - half, c + half).padded(CLASSIFY_PAD);
+        let padded = Aabb::new(c - half, c + half).padded(CLASSIFY_PAD);
+        let root = Cell {
+            min: padded.min,
+            side: padded.extent().max_element(),
+        };
+        tree.bounds = root.aabb();
         let mut builder = Builder {
             shapes,
             params,
@@ -237,11 +285,10 @@ impl Octree {
             refs: Blocks::new(),
             stats: tree.stats,
         };
-        builder.nodes.extend(&[Node { first: 0, count: 0 }])?;
+        builder.nodes.extend(&[Node::EMPTY])?;
         let root = Pending {
             slot: 0,
-            min: tree.bounds.min,
-            max: tree.bounds.max,
+            cell: root,
             items: bounded,
             non_separating: 0,
         };
@@ -251,12 +298,24 @@ impl Octree {
         } = builder;
         tree.nodes = nodes.into_vec()?;
         tree.refs = refs.into_vec()?;
-        let leaves = tree.nodes.iter().filter(|n| n.count != INTERIOR).count() as u64;
-        let empty = tree.nodes.iter().filter(|n| n.count == 0).count() as u64;
+        // Havran's counts include the empty octants, which are not stored
+        // (only a root without shapes is a stored empty leaf).
+        let stored_leaves = tree.nodes.iter().filter(|n| n.is_leaf()).count() as u64;
+        let unstored: u64 = tree
+            .nodes
+            .iter()
+            .filter(|n| !n.is_leaf())
+            .map(|n| 8 - n.mask().count_ones() as u64)
+            .sum();
+        let stored_empty = tree
+            .nodes
+            .iter()
+            .filter(|n| n.is_leaf() && n.count() == 0)
+            .count() as u64;
         tree.stats = OctreeStats {
-            nodes: tree.nodes.len() as u64,
-            leaves,
-            empty_leaves: empty,
+            nodes: tree.nodes.len() as u64 + unstored,
+            leaves: stored_leaves + unstored,
+            empty_leaves: stored_empty + unstored,
             references: tree.refs.len() as u64,
             memory_bytes: (tree.nodes.len() * std::mem::size_of::<Node>()
                 + (tree.refs.len() + tree.unbounded.len()) * 4) as u64,
@@ -283,51 +342,51 @@ impl Octree {
     pub fn cells(&self, depth: u32) -> Vec<OctreeCell> {
         let mut out = Vec::new();
         if !self.nodes.is_empty() && !self.bounds.is_empty() {
-            self.collect_cells(0, self.bounds.min, self.bounds.max, 0, depth, &mut out);
+            self.collect_cells(0, self.root_cell(), 0, depth, &mut out);
         }
         out
+    }
+
+    fn root_cell(&self) -> Cell {
+        Cell {
+            min: self.bounds.min,
+            side: self.bounds.max.x - self.bounds.min.x,
+        }
     }
 
     /// Returns the references under node `index`.
     fn collect_cells(
         &self,
         index: usize,
-        min: DVec3,
-        max: DVec3,
+        cell: Cell,
         level: u32,
         depth: u32,
         out: &mut Vec<OctreeCell>,
     ) -> u64 {
         let node = self.nodes[index];
-        if node.count != INTERIOR {
-            if node.count > 0 {
+        if node.is_leaf() {
+            if node.count() > 0 {
                 out.push(OctreeCell {
-                    bounds: Aabb::new(min, max),
+                    bounds: cell.aabb(),
                     depth: level,
-                    references: node.count as u64,
+                    references: node.count() as u64,
                 });
             }
-            return node.count as u64;
+            return node.count() as u64;
         }
-        let mid = centre(min, max);
         let at_limit = level >= depth;
         let mut below = Vec::new();
         let target = if at_limit { &mut below } else { &mut *out };
         let mut total = 0;
-        for child in 0..8 {
-            let (lo, hi) = octant(min, max, mid, child);
-            total += self.collect_cells(
-                node.first as usize + child,
-                lo,
-                hi,
-                level + 1,
-                depth,
-                target,
-            );
+        for c in 0..8 {
+            if node.mask() >> c & 1 == 1 {
+                let child = node.child(c) as usize;
+                total += self.collect_cells(child, cell.child(c), level + 1, depth, target);
+            }
         }
         if at_limit && total > 0 {
             out.push(OctreeCell {
-                bounds: Aabb::new(min, max),
+                bounds: cell.aabb(),
                 depth: level,
                 references: total,
             });
@@ -359,29 +418,31 @@ impl Octree {
         visitor.best
     }
 
-    /// What a shadow ray meets over `(0, t_max)`.
+    /// What a shadow ray meets over `(0, t_max)`, into `found` (cleared
+    /// first; the caller keeps it, so no ray initialises the array).
     pub fn occlusion<C: Counter>(
         &self,
         prims: &Primitives,
         ray: &PreparedRay,
         t_max: f64,
+        found: &mut ShadowCrossings,
         counter: &mut C,
-    ) -> ShadowCrossings {
+    ) {
+        found.clear();
+        for &i in &self.unbounded {
+            if test_occlusion(prims, i, ray, t_max, found, counter) {
+                return;
+            }
+        }
         let mut visitor = OcclusionVisitor {
             prims,
             ray,
             t_max,
-            found: ShadowCrossings::default(),
+            found,
             mailbox: Mailbox::new(),
             counter,
         };
-        for &i in &self.unbounded {
-            if test_occlusion(prims, i, ray, t_max, &mut visitor.found, visitor.counter) {
-                return visitor.found;
-            }
-        }
         self.traverse(ray, t_max, &mut visitor);
-        visitor.found
     }
 
     fn traverse<V: LeafVisitor>(&self, ray: &PreparedRay, t_max: f64, visitor: &mut V) {
@@ -392,121 +453,145 @@ impl Octree {
         let Some((t0, t1)) = self.bounds.ray_range(&walk.ray, 0.0, t_max) else {
             return;
         };
-        self.visit(0, self.bounds.min, self.bounds.max, t0, t1, &walk, visitor);
+        STACK.with_borrow_mut(|stack| {
+            stack.entries[0] = Entry {
+                node: 0,
+                cell: self.root_cell(),
+                t0,
+                t1,
+            };
+            self.walk(&walk, stack, visitor);
+        });
     }
 
-    /// Visits child `index` of a node; empty leaves are counted and skipped
-    /// without a call (a large share of the leaves a ray enters are empty).
-    #[allow(clippy::too_many_arguments)]
+    /// The traversal proper: pops cells front to back until the visitor
+    /// stops or nothing further along the ray can matter.
     #[inline(always)]
-    fn visit_child<V: LeafVisitor>(
-        &self,
-        index: u32,
-        min: DVec3,
-        max: DVec3,
-        t0: f64,
-        t1: f64,
-        ray: &WalkRay,
-        visitor: &mut V,
-    ) -> bool {
-        if self.nodes[index as usize].count == 0 {
-            visitor.counter().traversal_step();
-            visitor.counter().leaf_visit();
-            return false;
-        }
-        self.visit(index, min, max, t0, t1, ray, visitor)
-    }
-
-    /// Visits node `index` over the ray segment `[t0, t1]`; `true` once
-    /// nothing further along the ray can matter.
-    #[allow(clippy::too_many_arguments)]
-    fn visit<V: LeafVisitor>(
-        &self,
-        index: u32,
-        min: DVec3,
-        max: DVec3,
-        t0: f64,
-        t1: f64,
-        ray: &WalkRay,
-        visitor: &mut V,
-    ) -> bool {
-        visitor.counter().traversal_step();
-        let node = self.nodes[index as usize];
-        if node.count != INTERIOR {
-            visitor.counter().leaf_visit();
-            let refs = &self.refs[node.first as usize..(node.first + node.count) as usize];
-            return visitor.visit_leaf(refs, t1);
-        }
-        let mid = centre(min, max);
-        // Parameters of the three mid-planes and the octant entered at t0.
-        let mut t_mid = [f64::INFINITY; 3];
-        let mut child = 0usize;
-        for k in 0..3 {
-            let d = ray.ray.dir[k];
-            if d == 0.0 {
-                // Parallel to the plane (or in it): the side never changes;
-                // a ray lying in the plane goes to the upper octants.
-                if ray.ray.origin[k] >= mid[k] {
-                    child |= 1 << k;
-                }
-            } else {
-                let t = (mid[k] - ray.ray.origin[k]) * ray.inv_dir[k];
-                t_mid[k] = t;
-                // Upper side at t0: already crossed going up, or not yet crossed going down.
-                if (t <= t0) == (d > 0.0) {
-                    child |= 1 << k;
-                }
+    fn walk<V: LeafVisitor>(&self, ray: &WalkRay, stack: &mut Stack, visitor: &mut V) {
+        let (o, d, inv) = (ray.ray.origin, ray.ray.dir, ray.inv_dir);
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let e = stack.entries[top];
+            // The stack holds cells in order along the ray, nearest on top:
+            // once one starts past the limit, all the others do.
+            if e.t0 > visitor.t_limit() {
+                return;
             }
-        }
-        // Crossings in increasing t (a three-element sorting network).
-        let mut order = [0usize, 1, 2];
-        if t_mid[order[0]] > t_mid[order[1]] {
-            order.swap(0, 1);
-        }
-        if t_mid[order[1]] > t_mid[order[2]] {
-            order.swap(1, 2);
-        }
-        if t_mid[order[0]] > t_mid[order[1]] {
-            order.swap(0, 1);
-        }
-        let mut t_start = t0;
-        for k in order {
-            let t = t_mid[k];
-            if !(t > t0 && t < t1) {
+            visitor.counter().traversal_step();
+            let node = self.nodes[e.node as usize];
+            if node.is_leaf() {
+                visitor.counter().leaf_visit();
+                let first = node.first as usize;
+                let refs = &self.refs[first..first + node.count() as usize];
+                if visitor.visit_leaf(refs, e.t1) {
+                    return;
+                }
                 continue;
             }
-            if t_start > visitor.t_limit() {
-                return true;
+            let mid = e.cell.mid();
+            // Parameters of the three mid-planes, and the octant entered at
+            // t0: on a plane's upper side once it is crossed going up, or
+            // until it is crossed going down. A ray parallel to a plane (or
+            // in it: upper) never crosses it: its parameter is -inf on the
+            // upper side, +inf on the lower, which gives the same rule.
+            let mut t_mid = [0.0f64; 3];
+            let mut child = 0usize;
+            for k in 0..3 {
+                let t = if d[k] == 0.0 {
+                    if o[k] >= mid[k] {
+                        f64::NEG_INFINITY
+                    } else {
+                        f64::INFINITY
+                    }
+                } else {
+                    (mid[k] - o[k]) * inv[k]
+                };
+                t_mid[k] = t;
+                child |= (((t <= e.t0) != ray.negative[k]) as usize) << k;
             }
-            let (cmin, cmax) = octant(min, max, mid, child);
-            if self.visit_child(
-                node.first + child as u32,
-                cmin,
-                cmax,
-                t_start,
-                t,
-                ray,
-                visitor,
-            ) {
-                return true;
+            // The crossings inside the cell, in increasing t: the children
+            // the ray passes through follow by flipping one bit at each.
+            let mut inside = [0usize; 3];
+            let mut n_inside = 0;
+            for k in 0..3 {
+                if t_mid[k] > e.t0 && t_mid[k] < e.t1 {
+                    inside[n_inside] = k;
+                    n_inside += 1;
+                }
             }
-            child ^= 1 << k;
-            t_start = t;
+            // At most three: compare and swap (ties keep axis order).
+            let earlier = |a: usize, b: usize| t_mid[a] > t_mid[b];
+            if n_inside > 1 && earlier(inside[0], inside[1]) {
+                inside.swap(0, 1);
+            }
+            if n_inside > 2 {
+                if earlier(inside[1], inside[2]) {
+                    inside.swap(1, 2);
+                }
+                if earlier(inside[0], inside[1]) {
+                    inside.swap(0, 1);
+                }
+            }
+            let crossings = &inside[..n_inside];
+            let mut sequence = [(0usize, 0.0f64, 0.0f64); 4];
+            let mut t_start = e.t0;
+            for (i, &k) in crossings.iter().enumerate() {
+                sequence[i] = (child, t_start, t_mid[k]);
+                child ^= 1 << k;
+                t_start = t_mid[k];
+            }
+            sequence[n_inside] = (child, t_start, e.t1);
+            // Farthest first, so the nearest is popped next. Empty octants
+            // are counted as entered leaves (Havran's measures) but cost
+            // nothing else.
+            let limit = visitor.t_limit();
+            let mask = node.mask();
+            for &(c, ts, te) in sequence[..=n_inside].iter().rev() {
+                if mask >> c & 1 == 0 {
+                    if ts <= limit {
+                        visitor.counter().traversal_step();
+                        visitor.counter().leaf_visit();
+                    }
+                    continue;
+                }
+                stack.entries[top] = Entry {
+                    node: node.child(c),
+                    cell: e.cell.child(c),
+                    t0: ts,
+                    t1: te,
+                };
+                top += 1;
+            }
         }
-        if t_start > visitor.t_limit() {
-            return true;
-        }
-        let (cmin, cmax) = octant(min, max, mid, child);
-        self.visit_child(
-            node.first + child as u32,
-            cmin,
-            cmax,
-            t_start,
-            t1,
-            ray,
-            visitor,
-        )
     }
+}
+
+/// A cell waiting on the traversal stack, with the ray's parameters at its
+/// entry and exit.
+#[derive(Clone, Copy, Debug, Default)]
+struct Entry {
+    node: u32,
+    cell: Cell,
+    t0: f64,
+    t1: f64,
+}
+
+/// Deepest stack a walk needs: each level leaves at most three siblings
+/// waiting, plus the cell being entered.
+const STACK_CAPACITY: usize = 3 * MAX_OCTREE_DEPTH as usize + 4;
+
+/// The cells a walk has still to visit.
+struct Stack {
+    entries: [Entry; STACK_CAPACITY],
+}
+
+thread_local! {
+    /// One traversal stack per thread, reused by every ray (a traversal
+    /// never starts another on the same thread), so no ray initialises it.
+    static STACK: std::cell::RefCell<Stack> = std::cell::RefCell::new(Stack {
+        entries: [Entry::default(); STACK_CAPACITY],
+    });
 }
 
 /// The ray as the traversal sees it: direction components too small to
@@ -515,6 +600,8 @@ impl Octree {
 struct WalkRay {
     ray: crate::math::Ray,
     inv_dir: DVec3,
+    /// Per axis: the direction is negative.
+    negative: [bool; 3],
 }
 
 impl WalkRay {
@@ -529,7 +616,12 @@ impl WalkRay {
                 ray.dir[k] = 0.0;
             }
         }
-        Self { ray, inv_dir }
+        let negative = [ray.dir.x < 0.0, ray.dir.y < 0.0, ray.dir.z < 0.0];
+        Self {
+            ray,
+            inv_dir,
+            negative,
+        }
     }
 }
 
@@ -606,7 +698,7 @@ struct OcclusionVisitor<'a, C> {
     prims: &'a Primitives<'a>,
     ray: &'a PreparedRay,
     t_max: f64,
-    found: ShadowCrossings,
+    found: &'a mut ShadowCrossings,
     mailbox: Mailbox,
     counter: &'a mut C,
 }
@@ -626,7 +718,7 @@ impl<C: Counter> LeafVisitor for OcclusionVisitor<'_, C> {
                     i,
                     self.ray,
                     self.t_max,
-                    &mut self.found,
+                    self.found,
                     self.counter,
                 )
             {
@@ -658,8 +750,7 @@ const MAX_NON_SEPARATING_SPLITS: u8 = 2;
 /// split without separating anything.
 struct Pending {
     slot: u32,
-    min: DVec3,
-    max: DVec3,
+    cell: Cell,
     items: Vec<u32>,
     non_separating: u8,
 }
@@ -790,15 +881,11 @@ impl Builder<'_> {
         // The smallest possible split (eight empty children) must fit.
         if depth >= params.max_depth
             || n <= params.leaf_size as usize
-            || self.used + 8 * NODE_BYTES > self.budget
+            || self.used + NODE_BYTES > self.budget
         {
             return Ok(leaf);
         }
-        let mid = centre(p.min, p.max);
-        let cells: [Aabb; 8] = std::array::from_fn(|c| {
-            let (cmin, cmax) = octant(p.min, p.max, mid, c);
-            Aabb::new(cmin, cmax).padded(CLASSIFY_PAD)
-        });
+        let cells: [Aabb; 8] = std::array::from_fn(|c| p.cell.child(c).aabb().padded(CLASSIFY_PAD));
         // One byte per reference: the octants its surface touches. The
         // bounding box rules out octants cheaply; the exact test runs only
         // where the box spans several. A shape whose box meets a single
@@ -844,14 +931,11 @@ impl Builder<'_> {
         if params.cost_driven {
             // Expected cost of a ray through this node, in intersection tests,
             // as a leaf and split (children weighted by their relative area).
-            let area = Aabb::new(p.min, p.max).surface_area();
+            let area = p.cell.aabb().surface_area();
             if area > 0.0 {
                 let split_cost = TRAVERSAL_COST
                     + (0..8)
-                        .map(|c| {
-                            let (cmin, cmax) = octant(p.min, p.max, mid, c);
-                            Aabb::new(cmin, cmax).surface_area() / area * counts[c] as f64
-                        })
+                        .map(|c| p.cell.child(c).aabb().surface_area() / area * counts[c] as f64)
                         .sum::<f64>();
                 if split_cost >= n as f64 {
                     return Ok(leaf);
@@ -894,36 +978,39 @@ impl Builder<'_> {
                     .filter(|c| !c.is_empty())
                     .map(|c| PENDING_BYTES + REF_BYTES * c.len() as u64)
                     .sum();
-                let after = self.used - held + 8 * NODE_BYTES + queued;
+                let mask = (0..8).fold(0u32, |m, c| m | ((!children[c].is_empty() as u32) << c));
+                let stored = mask.count_ones() as u64;
+                let after = self.used - held + stored * NODE_BYTES + queued;
                 if after <= self.budget {
                     self.used = after;
                     let first = self.nodes.len;
-                    self.nodes.extend(&[Node { first: 0, count: 0 }; 8])?;
+                    // Only the non-empty octants get nodes.
+                    for _ in 0..stored {
+                        self.nodes.extend(&[Node::EMPTY])?;
+                    }
                     self.nodes.set(
                         p.slot as usize,
                         Node {
                             first: first as u32,
-                            count: INTERIOR,
+                            meta: INTERIOR | mask,
                         },
                     );
-                    let mid = centre(p.min, p.max);
                     let non_separating = if separates { 0 } else { p.non_separating + 1 };
+                    let mut slot = first as u32;
                     for (c, items) in children.into_iter().enumerate() {
-                        // Empty children are finished leaves already.
                         if items.is_empty() {
                             continue;
                         }
-                        let (min, max) = octant(p.min, p.max, mid, c);
                         try_push(
                             next,
                             Pending {
-                                slot: (first + c) as u32,
-                                min,
-                                max,
+                                slot,
+                                cell: p.cell.child(c),
                                 items,
                                 non_separating,
                             },
                         )?;
+                        slot += 1;
                     }
                     return Ok(());
                 }
@@ -937,7 +1024,7 @@ impl Builder<'_> {
             p.slot as usize,
             Node {
                 first: self.refs.len as u32,
-                count: p.items.len() as u32,
+                meta: p.items.len() as u32,
             },
         );
         self.refs.extend(&p.items)?;

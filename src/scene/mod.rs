@@ -8,6 +8,7 @@ pub mod polygon;
 pub mod toml_format;
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use crate::accel::OctreeParams;
 use crate::camera::CameraSpec;
@@ -70,6 +71,8 @@ pub struct ImageSettings {
     /// or display values (the NFF default).
     pub colors: ColorConvention,
     pub sides: Sides,
+    /// With 16 samples: refine only where the picture shows an edge.
+    pub adaptive: bool,
 }
 
 impl Default for ImageSettings {
@@ -83,6 +86,7 @@ impl Default for ImageSettings {
             ambient: DVec3::splat(0.1),
             colors: ColorConvention::Linear,
             sides: Sides::Two,
+            adaptive: false,
         }
     }
 }
@@ -98,11 +102,14 @@ pub struct Scene {
     pub materials: Vec<Material>,
     pub lights: Vec<Light>,
     /// Shapes and their material indices, side by side (structure of arrays:
-    /// the intersection loop touches only `shapes`).
-    pub shapes: Vec<Shape>,
-    pub shape_materials: Vec<u32>,
+    /// the intersection loop touches only `shapes`). The geometry is shared,
+    /// not copied, when a scene is cloned: the viewer edits lights and
+    /// materials of a scene the renderer still holds, and such an edit must
+    /// not copy a million triangles.
+    pub shapes: Arc<Vec<Shape>>,
+    pub shape_materials: Arc<Vec<u32>>,
     /// Per-triangle vertex normals of smooth-shaded triangles.
-    pub vertex_normals: Vec<[DVec3; 3]>,
+    pub vertex_normals: Arc<Vec<[DVec3; 3]>>,
     /// Degenerate triangles dropped while loading (they could never be hit).
     pub dropped_triangles: usize,
     /// Polygons dropped while loading: zero area, or not simple.
@@ -112,7 +119,7 @@ pub struct Scene {
     pub color_values: ColorConvention,
     /// The text the scene was parsed from, kept for reproducible exports
     /// (empty for scenes built in code).
-    pub source_text: String,
+    pub source_text: Arc<str>,
 }
 
 impl Scene {
@@ -126,19 +133,19 @@ impl Scene {
             octree_params: OctreeParams::default(),
             materials: Vec::new(),
             lights: Vec::new(),
-            shapes: Vec::new(),
-            shape_materials: Vec::new(),
-            vertex_normals: Vec::new(),
+            shapes: Arc::default(),
+            shape_materials: Arc::default(),
+            vertex_normals: Arc::default(),
             dropped_triangles: 0,
             dropped_polygons: DroppedPolygons::default(),
             color_values: ColorConvention::Linear,
-            source_text: String::new(),
+            source_text: Arc::from(""),
         }
     }
 
     pub fn push(&mut self, shape: Shape, material: u32) {
-        self.shapes.push(shape);
-        self.shape_materials.push(material);
+        Arc::make_mut(&mut self.shapes).push(shape);
+        Arc::make_mut(&mut self.shape_materials).push(material);
     }
 
     /// Adds triangles (with optional per-triangle vertex normals), dropping
@@ -164,7 +171,7 @@ impl Scene {
             && n.iter().all(|v| v.is_finite() && v.length_squared() > 0.0)
         {
             t.vertex_normals = self.vertex_normals.len() as u32;
-            self.vertex_normals.push(n);
+            Arc::make_mut(&mut self.vertex_normals).push(n);
         }
         self.push(Shape::Triangle(t), material);
     }
@@ -212,7 +219,7 @@ impl Scene {
     /// away does not make them any less precise.)
     pub fn geometry_bounds(&self) -> Aabb {
         let mut b = Aabb::EMPTY;
-        for shape in &self.shapes {
+        for shape in self.shapes.iter() {
             match shape {
                 Shape::Plane(p) => b = b.grow(p.point),
                 _ => {
@@ -228,7 +235,7 @@ impl Scene {
     /// Counts of shapes by kind, e.g. `[("sphere", 3), ("triangle", 12)]`.
     pub fn shape_counts(&self) -> Vec<(&'static str, usize)> {
         let mut counts: Vec<(&'static str, usize)> = Vec::new();
-        for s in &self.shapes {
+        for s in self.shapes.iter() {
             match counts.iter_mut().find(|(k, _)| *k == s.kind_name()) {
                 Some((_, n)) => *n += 1,
                 None => counts.push((s.kind_name(), 1)),
@@ -311,7 +318,7 @@ pub fn load_str(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene
             path: path.to_owned(),
         }),
     }?;
-    scene.source_text = text.to_owned();
+    scene.source_text = Arc::from(text);
     Ok(scene)
 }
 

@@ -56,6 +56,7 @@ struct ImageFile {
     ambient: Option<Vec3>,
     colors: Option<Spanned<String>>,
     sides: Option<Spanned<String>>,
+    aa: Option<Spanned<String>>,
 }
 
 #[derive(Deserialize, Default)]
@@ -250,6 +251,20 @@ pub fn parse(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, S
             .get_ref()
             .parse()
             .map_err(|e: String| cx.error(v.span(), "image.colors", e))?;
+    }
+    if let Some(v) = &im.aa {
+        if im.samples.is_some() {
+            return Err(cx.error(v.span(), "image.aa", "give `samples` or `aa`, not both"));
+        }
+        let aa: crate::settings::AntiAliasing = v
+            .get_ref()
+            .parse()
+            .map_err(|e: String| cx.error(v.span(), "image.aa", e))?;
+        (image.samples, image.adaptive) = match aa {
+            crate::settings::AntiAliasing::Off => (1, false),
+            crate::settings::AntiAliasing::Adaptive => (16, true),
+            crate::settings::AntiAliasing::Full => (16, false),
+        };
     }
     if let Some(v) = &im.sides {
         image.sides = v

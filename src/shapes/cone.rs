@@ -117,6 +117,37 @@ impl Cone {
         }
     }
 
+    /// Whether the surface may touch the closed box `b`: the box must come
+    /// within the larger radius of the axis segment (the cone lies inside
+    /// that capsule). Conservative, and far tighter than the bounding box
+    /// for thin slanted cylinders such as the SPD's rings and tree.
+    pub fn overlaps_box(&self, b: &Aabb) -> bool {
+        if !self.bounds().overlaps(b) {
+            return false;
+        }
+        let r = self.base_radius.max(self.apex_radius);
+        // The squared distance from the box to a point of the axis is
+        // convex along the segment: a ternary search finds its minimum.
+        let distance2 = |s: f64| {
+            let p = self.base + s * (self.apex - self.base);
+            p.distance_squared(p.clamp(b.min, b.max))
+        };
+        let (mut lo, mut hi) = (0.0f64, 1.0f64);
+        for _ in 0..64 {
+            let (m1, m2) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
+            if distance2(m1) <= distance2(m2) {
+                hi = m2;
+            } else {
+                lo = m1;
+            }
+        }
+        let nearest = distance2(0.5 * (lo + hi))
+            .min(distance2(0.0))
+            .min(distance2(1.0));
+        // A relative margin keeps the test conservative under rounding.
+        nearest <= r * r * (1.0 + 1e-9) + 1e-18 * self.height * self.height
+    }
+
     pub fn bounds(&self) -> Aabb {
         // A disk of radius r with unit normal a extends r sqrt(1 - a_k^2) along axis k.
         let spread = (DVec3::ONE - self.axis * self.axis).max(DVec3::ZERO);
@@ -159,5 +190,21 @@ mod tests {
             assert!(b.contains(tilted.base + 0.5 * rim) && b.contains(tilted.apex + 0.2 * rim));
         }
         assert!(Cone::new(DVec3::ONE, 1.0, DVec3::ONE, 1.0).is_none());
+    }
+
+    #[test]
+    fn box_overlap_follows_the_axis_not_the_bounding_box() {
+        // A thin diagonal cylinder: its bounding box is the whole unit cube.
+        let c = Cone::new(DVec3::ZERO, 0.05, DVec3::ONE, 0.05).unwrap();
+        let corner = Aabb::new(DVec3::new(0.8, 0.0, 0.0), DVec3::new(1.0, 0.2, 0.2));
+        assert!(c.bounds().overlaps(&corner));
+        assert!(!c.overlaps_box(&corner), "far from the axis");
+        let on_axis = Aabb::new(DVec3::splat(0.45), DVec3::splat(0.55));
+        assert!(c.overlaps_box(&on_axis));
+        let touching = Aabb::new(
+            DVec3::new(0.5 + 0.05 / 2f64.sqrt(), 0.5 - 0.05 / 2f64.sqrt(), 0.0),
+            DVec3::new(0.9, 0.9, 1.0),
+        );
+        assert!(c.overlaps_box(&touching), "a box reaching the surface");
     }
 }

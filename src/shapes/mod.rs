@@ -219,11 +219,13 @@ impl Shape {
 
     /// Whether the shape's surface may touch the closed box `b`: exact for
     /// triangles and spheres (a box inside a sphere does not touch its
-    /// surface), by bounding box otherwise. Never false when it does touch.
+    /// surface), by the enclosing capsule for cones, by bounding box
+    /// otherwise. Never false when it does touch.
     pub fn overlaps_box(&self, b: &Aabb) -> bool {
         match self {
             Shape::Sphere(s) => s.overlaps_box(b),
             Shape::Triangle(t) => triangle_overlaps_box(&t.vertices, b),
+            Shape::Cone(c) => c.overlaps_box(b),
             _ => self.bounds().is_none_or(|sb| sb.overlaps(b)),
         }
     }

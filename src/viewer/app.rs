@@ -55,7 +55,7 @@ pub struct ViewerOptions {
     /// Initial settings that differ from the scene's (view mode, octree, AA).
     pub view: Option<ViewMode>,
     pub octree: Option<bool>,
-    pub anti_aliasing: Option<bool>,
+    pub anti_aliasing: Option<crate::render::AntiAliasing>,
     /// Image size overriding the scene's.
     pub size: Option<(u32, u32)>,
     /// Start with the octree overlay drawn down to this level.
@@ -149,7 +149,9 @@ impl GlintApp {
         let scene = source.load()?;
         let worker = Worker::spawn(options.threads, repaint);
         let mut settings = RenderSettings::from_scene(&scene);
-        let anti_aliasing = options.anti_aliasing.unwrap_or(scene.image.samples == 16);
+        let aa = options.anti_aliasing.unwrap_or(settings.anti_aliasing());
+        let anti_aliasing = aa != crate::render::AntiAliasing::Off;
+        settings.adaptive = aa == crate::render::AntiAliasing::Adaptive;
         if let Some(v) = options.view {
             settings.view = v;
         }

@@ -113,6 +113,17 @@ pub fn controls_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                         "Anti-aliasing (16 samples, 4x4 grid)",
                     ),
                 );
+                ui.add_enabled(
+                    !spd && app.anti_aliasing,
+                    egui::Checkbox::new(
+                        &mut app.settings.adaptive,
+                        "only where the picture needs it (adaptive)",
+                    ),
+                )
+                .on_hover_text(
+                    "trace every pixel's centre, then the 4x4 grid only where neighbours differ: \
+                     another material, a shadow edge, a visible contrast",
+                );
                 ui.checkbox(&mut app.settings.use_octree, "Octree");
                 ui.horizontal(|ui| {
                     ui.label("Max depth");
@@ -300,6 +311,17 @@ fn timing_grid_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
             match last(PassKind::SixteenSamples) {
                 Some(r) => row("16-sample pass", format!("{:.3} s", r.seconds)),
                 None => row("16-sample pass", "–".into()),
+            }
+            if let Some(r) = last(PassKind::SixteenSamples)
+                && let Some(refined) = r.refined_pixels
+            {
+                row(
+                    "refined (adaptive)",
+                    format!(
+                        "{:.1}% of pixels",
+                        100.0 * refined as f64 / (r.width as f64 * r.height as f64).max(1.0)
+                    ),
+                );
             }
             if let (Some(a), Some(b)) = (last(PassKind::OneSample), last(PassKind::SixteenSamples))
             {

@@ -74,6 +74,9 @@ pub struct PassRecord {
     /// For a 16-sample pass: the error of the same generation's 1-sample
     /// pass against it (what anti-aliasing changed).
     pub one_sample_error: Option<crate::render::ImageError>,
+    /// For an adaptive 16-sample pass: the pixels it refined (the rest kept
+    /// their 1-sample value).
+    pub refined_pixels: Option<u64>,
 }
 
 /// The display buffer: RGBA8, exactly what the viewer shows and exports.
@@ -117,8 +120,9 @@ impl std::fmt::Debug for FrameSource {
 }
 
 /// The 1-sample frame of the generation being refined, kept by the worker
-/// to measure what the 16-sample pass changes.
-type OneSampleFrame = Mutex<Option<(u64, Frame)>>;
+/// to measure what the 16-sample pass changes, with the signatures of what
+/// each pixel's ray met (for adaptive anti-aliasing; empty otherwise).
+type OneSampleFrame = Mutex<Option<(u64, Frame, Vec<u64>)>>;
 
 struct Shared {
     generation: AtomicU64,
@@ -364,6 +368,26 @@ fn render_pass(
         b.finished = false;
         b.version += 1;
     }
+    // Adaptive anti-aliasing: the 1-sample pass keeps what each pixel's ray
+    // met, the 16-sample pass refines where that or the picture has an edge.
+    let adaptive = settings.anti_aliasing() == crate::render::AntiAliasing::Adaptive
+        || (kind == PassKind::OneSample && job.settings.adaptive && job.anti_aliasing);
+    let first_pass = if kind == PassKind::SixteenSamples && adaptive {
+        let one = shared.one_sample.lock().unwrap_or_else(|e| e.into_inner());
+        one.as_ref()
+            .filter(|(g, f, sig)| *g == generation && f.pixels.len() == sig.len() && f.width == w)
+            .map(|(_, f, sig)| {
+                let mask = crate::adaptive::refine_mask(&f.to_rgb8(), sig, w, h);
+                (f.pixels.clone(), mask)
+            })
+    } else {
+        None
+    };
+    let signatures = Mutex::new(if kind == PassKind::OneSample && adaptive {
+        vec![0u64; (w * h) as usize]
+    } else {
+        Vec::new()
+    });
     let start = Instant::now();
     let done = AtomicU64::new(0);
     let depth_range = Mutex::new((f64::INFINITY, f64::NEG_INFINITY));
@@ -375,7 +399,16 @@ fn render_pass(
                 return None;
             }
             count_tile(shared, generation);
-            let (values, counts) = renderer.render_tile(tile, false);
+            let (values, counts) = match &first_pass {
+                Some((pixels, mask)) => renderer.refine_tile(tile, pixels, mask, false),
+                None if kind == PassKind::OneSample && adaptive => {
+                    let (values, sig, counts) = renderer.first_pass_tile(tile, false);
+                    let mut all_sig = signatures.lock().unwrap_or_else(|e| e.into_inner());
+                    crate::render::place_tile(&mut all_sig, w, &tile, &sig);
+                    (values, counts)
+                }
+                None => renderer.render_tile(tile, false),
+            };
             let rgba = tile_rgba(&values, &settings, &depth_range);
             {
                 let mut b = shared.buffer.lock().unwrap_or_else(|e| e.into_inner());
@@ -405,13 +438,17 @@ fn render_pass(
         let mut one = shared.one_sample.lock().unwrap_or_else(|e| e.into_inner());
         match kind {
             PassKind::OneSample => {
-                *one = Some((generation, frame.clone()));
+                let sig =
+                    std::mem::take(&mut *signatures.lock().unwrap_or_else(|e| e.into_inner()));
+                *one = Some((generation, frame.clone(), sig));
                 None
             }
             PassKind::SixteenSamples => one
                 .as_ref()
-                .filter(|(g, f)| *g == generation && f.pixels.len() == frame.pixels.len())
-                .map(|(_, f)| crate::render::image_error(&f.pixels, &frame.pixels, frame.colors)),
+                .filter(|(g, f, _)| *g == generation && f.pixels.len() == frame.pixels.len())
+                .map(|(_, f, _)| {
+                    crate::render::image_error(&f.pixels, &frame.pixels, frame.colors)
+                }),
             PassKind::Preview { .. } | PassKind::Corners => None,
         }
     };
@@ -419,7 +456,7 @@ fn render_pass(
         (ViewMode::AaNeed, PassKind::SixteenSamples) => {
             let one = shared.one_sample.lock().unwrap_or_else(|e| e.into_inner());
             match one.as_ref() {
-                Some((g, f)) if *g == generation && f.pixels.len() == frame.pixels.len() => {
+                Some((g, f, _)) if *g == generation && f.pixels.len() == frame.pixels.len() => {
                     Frame::aa_need(f, &frame)
                 }
                 _ => frame,
@@ -450,6 +487,7 @@ fn render_pass(
             height: h,
             finished_at: shared.started.elapsed().as_secs_f64(),
             one_sample_error,
+            refined_pixels: first_pass.is_some().then_some(counts.refined_pixels),
         });
     }
     (shared.repaint)();

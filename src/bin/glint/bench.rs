@@ -24,6 +24,9 @@ pub struct BenchArgs {
     /// protocol shoots the pixel corners instead.
     #[arg(long, value_parser = parse_samples)]
     pub samples: Option<u32>,
+    /// Anti-aliasing: off, adaptive or full (see `glint render --aa`).
+    #[arg(long, value_parser = crate::common::parse_aa, conflicts_with = "samples")]
+    pub aa: Option<glint::render::AntiAliasing>,
     /// Longest ray path (default: each scene's own; the SPD protocol fixes 5).
     #[arg(long, value_parser = parse_positive)]
     pub max_depth: Option<u32>,
@@ -45,6 +48,14 @@ pub struct BenchArgs {
     /// configurations then time the same rows, and the output says so).
     #[arg(long, default_value_t = 4e9)]
     pub brute_force_budget: f64,
+    /// Time the octree only: no brute-force comparison (`octree_off` and
+    /// `speedup` are then left out of the JSON).
+    #[arg(long)]
+    pub octree_only: bool,
+    /// What the image shows (default: shaded); `normals` and `depth`
+    /// trace eye rays only.
+    #[arg(long, value_parser = |s: &str| s.parse::<glint::render::ViewMode>())]
+    pub view: Option<glint::render::ViewMode>,
     /// Instead of octree on/off, sweep the octree parameters: every
     /// combination of these maximum depths, leaf sizes and cost-driven
     /// on/off, octree on, one row each (medians of `--repeat` runs).
@@ -98,9 +109,11 @@ struct SceneBench {
     octree_params: glint::accel::OctreeParams,
     octree_stats: OctreeStats,
     octree_on: Timing,
-    octree_off: Timing,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    octree_off: Option<Timing>,
     /// Brute force time over octree time, measured on the same rays.
-    speedup: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    speedup: Option<f64>,
     /// Rows traced by the brute-force comparison: every n-th (1 = all).
     compared_rows_every: u32,
     /// Render time with work counting on over off (octree on, whole image).
@@ -214,7 +227,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let brute_tests = scene.shapes.len() as f64 * rays_total as f64;
         let every =
             ((brute_tests / args.brute_force_budget).ceil() as u32).clamp(1, settings.height);
-        let counted_off = pool.install(|| renderer_off.trace_rows(every, true));
+        let counted_off =
+            (!args.octree_only).then(|| pool.install(|| renderer_off.trace_rows(every, true)));
 
         // Timed passes, interleaved so drift in machine speed hits both alike.
         let (mut full_on, mut rows_on, mut rows_off) = (Vec::new(), Vec::new(), Vec::new());
@@ -225,16 +239,19 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             if r > 0 {
                 counted_times.push(timed(|| pool.install(|| renderer_on.render(true, None))).1);
             }
+            if args.octree_only {
+                continue;
+            }
             if every > 1 {
                 rows_on.push(timed(|| pool.install(|| renderer_on.trace_rows(every, false))).1);
             }
             rows_off.push(timed(|| pool.install(|| renderer_off.trace_rows(every, false))).1);
         }
         let on_s = median(full_on);
-        let off_rows_s = median(rows_off);
-        let on_rows_s = if every > 1 { median(rows_on) } else { on_s };
-        let speedup = off_rows_s / on_rows_s;
-        let off_s = on_s * speedup;
+        let speedup = (!args.octree_only).then(|| {
+            let on_rows_s = if every > 1 { median(rows_on) } else { on_s };
+            median(rows_off.clone()) / on_rows_s
+        });
         let per_ray = |c: &TileCounts, x: u64| x as f64 / c.rays.total().max(1) as f64;
         let timing = |c: &TileCounts, seconds: f64, rays_in_time: f64, estimated: bool| Timing {
             render_s: seconds,
@@ -259,12 +276,19 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             octree_params: scene.octree_params,
             octree_stats: octree.stats(),
             octree_on: timing(&counted_on, on_s, rays_total as f64, false),
-            octree_off: timing(
-                &counted_off,
-                off_rows_s,
-                counted_off.rays.total() as f64,
-                every > 1,
-            ),
+            // The whole-image estimate, with throughput measured on the subset.
+            octree_off: counted_off
+                .as_ref()
+                .zip(speedup)
+                .map(|(c, speedup)| Timing {
+                    render_s: on_s * speedup,
+                    ..timing(
+                        c,
+                        median(rows_off.clone()),
+                        c.rays.total() as f64,
+                        every > 1,
+                    )
+                }),
             speedup,
             compared_rows_every: every,
             counting_overhead: median(counted_times) / on_s,
@@ -276,12 +300,6 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 .then(|| published_counts(&path.display().to_string()))
                 .flatten(),
         });
-        if every > 1 {
-            // Report the whole-image estimate, with throughput measured on the subset.
-            if let Some(last) = results.last_mut() {
-                last.octree_off.render_s = off_s;
-            }
-        }
     }
     match args.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&results)?),
@@ -320,17 +338,18 @@ fn markdown(results: &[SceneBench]) -> String {
         let name = std::path::Path::new(&r.scene)
             .file_name()
             .map_or(r.scene.clone(), |n| n.to_string_lossy().into_owned());
-        let off = if r.octree_off.estimated {
-            format!(
+        let off = match &r.octree_off {
+            None => "–".to_string(),
+            Some(off) if off.estimated => format!(
                 "{:.2} (est., rows 1/{})",
-                r.octree_off.render_s, r.compared_rows_every
-            )
-        } else {
-            format!("{:.2}", r.octree_off.render_s)
+                off.render_s, r.compared_rows_every
+            ),
+            Some(off) => format!("{:.2}", off.render_s),
         };
+        let speedup = r.speedup.map_or("–".to_string(), |x| format!("{x:.1}x"));
         let havran = havran_best_nit(&r.scene).map_or("".to_string(), |x| format!("{x:.2}"));
         s.push_str(&format!(
-            "| {} | {} | {}x{} | {} | {:.3} | {:.3} | {} | {:.1}x | {:.2} | {:.2} | {:.2} | {:.2} | {} | {:.2}x |\n",
+            "| {} | {} | {}x{} | {} | {:.3} | {:.3} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {:.2}x |\n",
             name,
             r.shapes,
             r.width,
@@ -343,7 +362,7 @@ fn markdown(results: &[SceneBench]) -> String {
             r.build_s,
             r.octree_on.render_s,
             off,
-            r.speedup,
+            speedup,
             r.octree_on.mrays_per_s,
             r.octree_on.intersection_tests_per_ray,
             r.octree_on.traversal_steps_per_ray,
@@ -518,8 +537,15 @@ fn bench_settings(args: &BenchArgs, scene: &mut glint::scene::Scene) -> RenderSe
     if let Some((w, h)) = args.size {
         (settings.width, settings.height) = (w, h);
     }
-    settings.samples = args.samples.unwrap_or(settings.samples);
+    if let Some(samples) = args.samples {
+        settings.samples = samples;
+        settings.adaptive = false;
+    }
+    if let Some(aa) = args.aa {
+        settings.set_anti_aliasing(aa);
+    }
     settings.max_depth = args.max_depth.unwrap_or(settings.max_depth);
     args.rules.apply(&mut settings);
+    settings.view = args.view.unwrap_or(settings.view);
     settings
 }

@@ -42,6 +42,14 @@ pub fn parse_samples(s: &str) -> std::result::Result<u32, String> {
     }
 }
 
+/// `off`, `adaptive` or `full` (and the viewer's older `on` for full).
+pub fn parse_aa(s: &str) -> std::result::Result<glint::render::AntiAliasing, String> {
+    match s {
+        "on" => Ok(glint::render::AntiAliasing::Full),
+        _ => s.parse(),
+    }
+}
+
 /// `WIDTHxHEIGHT`, both at least 1.
 pub fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
     let (w, h) = s

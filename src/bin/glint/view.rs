@@ -26,9 +26,10 @@ pub struct ViewArgs {
     /// Start with the octree on or off (default: the scene's setting).
     #[arg(long, value_enum)]
     pub octree: Option<Switch>,
-    /// Start with anti-aliasing on or off (default: on if the scene asks for 16 samples).
-    #[arg(long, value_enum)]
-    pub aa: Option<Switch>,
+    /// Start with anti-aliasing off, adaptive or full (`on` is full;
+    /// default: the scene's).
+    #[arg(long, value_parser = crate::common::parse_aa)]
+    pub aa: Option<glint::render::AntiAliasing>,
     /// Image size as WIDTHxHEIGHT (default: the scene's).
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
@@ -101,7 +102,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         threads: args.threads,
         view: args.view,
         octree: args.octree.map(Switch::is_on),
-        anti_aliasing: args.aa.map(Switch::is_on),
+        anti_aliasing: args.aa,
         size: args.size,
         overlay_depth: args.overlay_depth,
         inspect: args.inspect,
