@@ -348,9 +348,13 @@ impl<'a> Renderer<'a> {
                 rec.shadow(|| verdict("faces-away", 0.0, Color::ZERO));
                 continue;
             }
-            rays.shadow += 1;
-            let shadow = PreparedRay::new(Ray::new(shadow_origin, l));
-            let pass = self.transmittance(&shadow, distance, counter);
+            let pass = if self.settings.shadows {
+                rays.shadow += 1;
+                let shadow = PreparedRay::new(Ray::new(shadow_origin, l));
+                self.transmittance(&shadow, distance, counter)
+            } else {
+                1.0
+            };
             rec.light(index, pass > 0.0);
             if pass == 0.0 {
                 rec.shadow(|| verdict("blocked", 0.0, Color::ZERO));

@@ -189,6 +189,14 @@ pub struct RenderSettings {
     /// only where the picture shows an edge (see [`crate::adaptive`]).
     #[serde(default)]
     pub adaptive: bool,
+    /// Cast shadow rays (off only in the viewer's previews while moving:
+    /// every light then reaches every point that faces it).
+    #[serde(default = "yes", skip_serializing_if = "Clone::clone")]
+    pub shadows: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 impl RenderSettings {
@@ -204,6 +212,7 @@ impl RenderSettings {
             colors: scene.image.colors,
             sides: scene.image.sides,
             adaptive: scene.image.adaptive,
+            shadows: true,
         }
     }
 

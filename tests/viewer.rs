@@ -130,7 +130,7 @@ fn job(
         camera: scene.camera,
         settings,
         anti_aliasing,
-        preview_divisor: 1,
+        preview: None,
     };
     (job, scene, octree)
 }
@@ -476,4 +476,29 @@ fn adaptive_refinement_pass_equals_the_cli_adaptive_render() {
         shown == frame.to_rgb8(),
         "the viewer's adaptive pass equals `glint render --aa adaptive`"
     );
+}
+
+#[test]
+fn a_budget_preview_drops_what_it_says() {
+    let worker = Worker::spawn(2, || {});
+    let (mut job, _, _) = job("scenes/glass.toml", 96, 72, true);
+    let preview = glint::viewer::worker::Preview {
+        divisor: 2,
+        reflections: false,
+        shadows: false,
+    };
+    job.preview = Some(preview);
+    let generation = worker.submit(job);
+    assert!(worker.wait_finished(generation, WAIT));
+    let passes: Vec<_> = worker
+        .history()
+        .into_iter()
+        .filter(|r| r.generation == generation)
+        .collect();
+    assert_eq!(passes.len(), 1, "one quick pass only");
+    let r = passes[0];
+    assert_eq!(r.kind, PassKind::Preview(preview));
+    assert_eq!((r.width, r.height), (48, 36));
+    assert_eq!(r.rays.primary, 48 * 36);
+    assert_eq!((r.rays.shadow, r.rays.reflection, r.rays.refraction), (0, 0, 0));
 }

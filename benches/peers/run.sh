@@ -82,32 +82,27 @@ median() {
 }
 
 # ---------------------------------------------------------------------------
-# >>> GLINT INVOCATION (replace these two functions with the precise one) <<<
-# Each prints one line "SECONDS MRAYS_PER_S": medians over $REPS runs.
+# glint: `glint bench --octree-only` times renders without work counting
+# (medians of $REPS); one `glint render --stats` gives the hit count.
+# Each function prints "SECONDS MRAYS_PER_S".
 # ---------------------------------------------------------------------------
 
 # Primary rays of scenes/bunny.toml, normals view, 1 sample per pixel.
 glint_bunny_primary() {
-    local t="$1" k secs=() mrays=()
-    for ((k = 0; k < REPS; k++)); do
-        "$GLINT" render scenes/bunny.toml --view normals --samples 1 --threads "$t" --stats \
-            -o /tmp/peers-glint.png >"$OUT/glint-bunny-$k.json"
-        secs+=("$(json "$OUT/glint-bunny-$k.json" 'j["render_s"]')")
-        mrays+=("$(json "$OUT/glint-bunny-$k.json" 'j["mrays_per_s"]')")
-    done
-    echo "$(median "${secs[@]}") $(median "${mrays[@]}")"
+    local t="$1"
+    "$GLINT" render scenes/bunny.toml --view normals --samples 1 --threads "$t" --stats \
+        -o "$OUT/glint-bunny.png" >"$OUT/glint-bunny-0.json"
+    "$GLINT" bench scenes/bunny.toml --view normals --samples 1 --size 1024x768 \
+        --octree-only --repeat "$REPS" --threads "$t" --format json >"$OUT/glint-bunny.json"
+    json "$OUT/glint-bunny.json" 'str(j[0]["octree_on"]["render_s"]) + " " + str(j[0]["octree_on"]["mrays_per_s"])'
 }
 
 # benches/peers/bunny_floor.toml: 16 samples per pixel, eye + shadow rays.
 glint_bunny_floor() {
-    local t="$1" k secs=() mrays=()
-    for ((k = 0; k < REPS; k++)); do
-        "$GLINT" render "$PEERS/bunny_floor.toml" --threads "$t" --stats \
-            -o /tmp/peers-floor.png >"$OUT/glint-floor-$k.json"
-        secs+=("$(json "$OUT/glint-floor-$k.json" 'j["render_s"]')")
-        mrays+=("$(json "$OUT/glint-floor-$k.json" 'j["mrays_per_s"]')")
-    done
-    echo "$(median "${secs[@]}") $(median "${mrays[@]}")"
+    local t="$1"
+    "$GLINT" bench "$PEERS/bunny_floor.toml" --octree-only --repeat "$REPS" --threads "$t" \
+        --format json >"$OUT/glint-floor.json"
+    json "$OUT/glint-floor.json" 'str(j[0]["octree_on"]["render_s"]) + " " + str(j[0]["octree_on"]["mrays_per_s"])'
 }
 # <<< END OF GLINT INVOCATION >>>
 # ---------------------------------------------------------------------------
@@ -158,6 +153,6 @@ EOF
 echo
 echo "- primary hits: glint $G_HITS, Embree $E_HITS (difference $((E_HITS - G_HITS))); Embree robust mode: $E_ROBUST"
 echo "- Mitsuba variant $M_VARIANT, $M_THREADS threads, warm-up render (JIT) ${M_WARM} s${M_FALLBACK:+; $M_FALLBACK}"
-echo "- glint: median of $REPS runs of render_s; Embree: median of 5; Mitsuba: median of 3 after a warm-up"
+echo "- glint: median of $REPS uncounted renders (glint bench --octree-only); Embree: median of 5; Mitsuba: median of 3 after a warm-up"
 echo "- Mitsuba's 16 spp are random (independent sampler), glint's a regular 4x4 grid"
 echo "- raw JSON: $OUT"

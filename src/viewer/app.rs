@@ -9,7 +9,7 @@ use egui::{
 };
 
 use super::orbit;
-use super::worker::{Job, PassKind, PassRecord, Worker};
+use super::worker::{Job, PassKind, PassRecord, Preview, Worker};
 use crate::accel::Octree;
 use crate::camera::CameraSpec;
 use crate::export::{RenderRecord, SceneEdits};
@@ -95,7 +95,7 @@ struct RenderInputs {
     settings: RenderSettings,
     anti_aliasing: bool,
     scene_version: u64,
-    preview_divisor: u32,
+    preview: Option<Preview>,
 }
 
 /// What the panels ask for; applied once per frame after the UI is drawn.
@@ -124,6 +124,10 @@ pub struct GlintApp {
     shown_version: u64,
     submitted: Option<RenderInputs>,
     pub(crate) dragging: bool,
+    /// Target time of a preview pass while the user drags (milliseconds).
+    pub(crate) frame_budget_ms: f64,
+    /// What the budget chose for the last drag, and its estimated seconds.
+    pub(crate) last_preview: Option<(Preview, f64)>,
     pub(crate) messages: Vec<Message>,
     pub(crate) commands: Vec<Command>,
     options: ViewerOptions,
@@ -195,6 +199,8 @@ impl GlintApp {
             shown_version: 0,
             submitted: None,
             dragging: false,
+            frame_budget_ms: 33.0,
+            last_preview: None,
             messages: Vec::new(),
             commands: Vec::new(),
             frames_since_final: 0,
@@ -304,26 +310,58 @@ impl GlintApp {
         }
     }
 
-    /// Preview divisor while dragging: the smallest of 1, 2, 4, 8 whose
-    /// estimated 1-sample pass time (last full 1-sample pass / divisor^2)
-    /// stays under 40 ms, so the image follows the mouse.
-    fn preview_divisor(&self, history: &[PassRecord]) -> u32 {
+    /// The preview to render while dragging (`None` when not): the best
+    /// image whose estimated time fits the frame budget. Candidates in order
+    /// of preference: full, 1/2, 1/4, 1/8 resolution, each first complete,
+    /// then without reflections, then without shadows too. Estimates come
+    /// from this scene's last full 1-sample pass (its time per pixel, and
+    /// its rays by kind for what dropping reflections or shadows saves),
+    /// corrected by how far the last preview's estimate was off.
+    fn choose_preview(&self, history: &[PassRecord]) -> Option<(Preview, f64)> {
         if !self.dragging {
-            return 1;
+            return None;
         }
-        let Some(last) = history
+        let fallback = Preview {
+            divisor: 4,
+            reflections: true,
+            shadows: true,
+        };
+        let Some(base) = history
             .iter()
             .rev()
             .find(|r| matches!(r.kind, PassKind::OneSample | PassKind::Corners))
         else {
-            return 4;
+            return Some((fallback, f64::NAN));
         };
-        let pixels_now = self.settings.width as f64 * self.settings.height as f64;
-        let per_pixel = last.seconds / (last.width as f64 * last.height as f64).max(1.0);
-        [1u32, 2, 4, 8]
-            .into_iter()
-            .find(|d| per_pixel * pixels_now / (*d as f64 * *d as f64) <= 0.040)
-            .unwrap_or(8)
+        let estimate = |p: &Preview| estimate_preview(base, p, &self.settings);
+        // How far off the model was on the last preview it predicted.
+        let correction = history
+            .iter()
+            .rev()
+            .find_map(|r| match r.kind {
+                PassKind::Preview(p) if r.finished_at > base.finished_at => {
+                    Some((r.seconds / estimate(&p)).clamp(0.25, 4.0))
+                }
+                _ => None,
+            })
+            .unwrap_or(1.0);
+        let budget = self.frame_budget_ms / 1000.0;
+        let candidates = [1u32, 2, 4, 8].into_iter().flat_map(|divisor| {
+            [(true, true), (false, true), (false, false)].map(|(reflections, shadows)| Preview {
+                divisor,
+                reflections,
+                shadows,
+            })
+        });
+        let mut last = None;
+        for p in candidates {
+            let t = estimate(&p) * correction;
+            if t <= budget {
+                return Some((p, t));
+            }
+            last = Some((p, t));
+        }
+        last
     }
 
     /// Submits a new job if anything that decides the image changed.
@@ -334,8 +372,11 @@ impl GlintApp {
             settings: self.settings,
             anti_aliasing: self.anti_aliasing,
             scene_version: self.scene_version,
-            preview_divisor: self.preview_divisor(&history),
+            preview: self.choose_preview(&history).map(|(p, _)| p),
         };
+        if let Some(choice) = self.choose_preview(&history) {
+            self.last_preview = Some(choice);
+        }
         if self.submitted.as_ref() == Some(&inputs) {
             return;
         }
@@ -345,7 +386,7 @@ impl GlintApp {
             camera: self.camera,
             settings: self.settings,
             anti_aliasing: self.anti_aliasing,
-            preview_divisor: inputs.preview_divisor,
+            preview: inputs.preview,
         });
         self.submitted = Some(inputs);
         // The inspected pixel follows the change: its rays are traced again
@@ -752,4 +793,93 @@ fn timestamp() -> String {
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0, |d| d.as_secs());
     format!("{secs}")
+}
+
+/// Estimated seconds of `preview` at the current settings, from the full
+/// 1-sample pass `base`: time per pixel times the pixels, times the share
+/// of its rays the preview still casts (dropping reflections drops the
+/// secondary rays and the shadow rays from their hits).
+fn estimate_preview(base: &PassRecord, preview: &Preview, settings: &RenderSettings) -> f64 {
+    let per_pixel = base.seconds / (base.width as f64 * base.height as f64).max(1.0);
+    let d = preview.divisor as f64;
+    let pixels = (settings.width as f64 / d).max(1.0) * (settings.height as f64 / d).max(1.0);
+    let r = base.rays;
+    let total = r.total().max(1) as f64;
+    let secondary = (r.reflection + r.refraction) as f64;
+    let hits = r.primary_hits as f64;
+    let mut shadow = r.shadow as f64;
+    let mut rays = total;
+    if !preview.reflections {
+        rays -= secondary;
+        // Shadow rays come from primary and secondary hits alike.
+        let kept = shadow * hits / (hits + secondary).max(1.0);
+        rays -= shadow - kept;
+        shadow = kept;
+    }
+    if !preview.shadows {
+        rays -= shadow;
+    }
+    per_pixel * pixels * (rays / total).max(0.05)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::stats::RayCounts;
+
+    fn base() -> PassRecord {
+        PassRecord {
+            generation: 1,
+            kind: PassKind::OneSample,
+            seconds: 0.4,
+            // 100 eye rays, 80 hit; 40 secondary rays; 240 shadow rays.
+            rays: RayCounts {
+                primary: 100,
+                primary_hits: 80,
+                shadow: 240,
+                reflection: 30,
+                refraction: 10,
+                total_internal_reflections: 0,
+            },
+            octree: true,
+            anti_aliasing: false,
+            width: 800,
+            height: 600,
+            finished_at: 1.0,
+            one_sample_error: None,
+            refined_pixels: None,
+        }
+    }
+
+    #[test]
+    fn preview_estimates_scale_with_pixels_and_rays_cast() {
+        let settings = RenderSettings {
+            width: 800,
+            height: 600,
+            samples: 1,
+            max_depth: 5,
+            use_octree: true,
+            view: crate::render::ViewMode::Shaded,
+            protocol: crate::render::Protocol::Glint,
+            colors: crate::color::ColorConvention::Linear,
+            sides: crate::render::Sides::Two,
+            adaptive: false,
+            shadows: true,
+        };
+        let p = |divisor, reflections, shadows| Preview {
+            divisor,
+            reflections,
+            shadows,
+        };
+        let full = estimate_preview(&base(), &p(1, true, true), &settings);
+        assert!((full - 0.4).abs() < 1e-12, "the base pass itself");
+        let half = estimate_preview(&base(), &p(2, true, true), &settings);
+        assert!((half - 0.1).abs() < 1e-12, "a quarter of the pixels");
+        // Without reflections: 100 eye rays and the 240 * 80/120 = 160
+        // shadow rays of eye-ray hits, of 380 rays.
+        let flat = estimate_preview(&base(), &p(1, false, true), &settings);
+        assert!((flat - 0.4 * 260.0 / 380.0).abs() < 1e-12, "{flat}");
+        let bare = estimate_preview(&base(), &p(1, false, false), &settings);
+        assert!((bare - 0.4 * 100.0 / 380.0).abs() < 1e-12, "{bare}");
+    }
 }

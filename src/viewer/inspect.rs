@@ -192,7 +192,7 @@ impl GlintApp {
             .worker
             .history()
             .iter()
-            .filter(|r| r.generation == generation && !matches!(r.kind, PassKind::Preview { .. }))
+            .filter(|r| r.generation == generation && !matches!(r.kind, PassKind::Preview(_)))
             .map(|r| format!("{} {:.3} s", r.kind.label(), r.seconds))
             .collect();
         if parts.is_empty() {

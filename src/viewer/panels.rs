@@ -153,6 +153,19 @@ pub fn controls_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                     }
                 });
                 ui.horizontal(|ui| {
+                    ui.label("Frame budget while moving");
+                    ui.add(
+                        DragValue::new(&mut app.frame_budget_ms)
+                            .range(5.0..=1000.0)
+                            .speed(1.0)
+                            .suffix(" ms"),
+                    )
+                    .on_hover_text(
+                        "while you drag, glint renders the best preview it estimates fits this time: \
+                         full resolution, then 1/2, 1/4, 1/8, each with and without reflections and shadows",
+                    );
+                });
+                ui.horizontal(|ui| {
                     ui.label("Image size");
                     ui.add(DragValue::new(&mut app.settings.width).range(1..=8192));
                     ui.label("x");
@@ -343,6 +356,22 @@ fn timing_grid_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                     );
                 }
             }
+            if let Some((p, estimate)) = app.last_preview {
+                let measured = history.iter().rev().find(|r| r.kind == PassKind::Preview(p));
+                row(
+                    "while moving",
+                    match measured {
+                        Some(r) => format!(
+                            "{} ({:.0} ms; est. {:.0} of {:.0})",
+                            p.describe(),
+                            1000.0 * r.seconds,
+                            1000.0 * estimate,
+                            app.frame_budget_ms
+                        ),
+                        None => format!("{} (est. {:.0} ms)", p.describe(), 1000.0 * estimate),
+                    },
+                );
+            }
             if let Some(r) = history.last() {
                 row(
                     "Mrays/s (last pass)",
@@ -409,7 +438,7 @@ fn timing_grid_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                     .filter(|r| {
                         r.octree == octree
                             && (r.kind == PassKind::SixteenSamples) == sixteen
-                            && !matches!(r.kind, PassKind::Preview { .. })
+                            && !matches!(r.kind, PassKind::Preview(_))
                     })
                     .map(|r| [r.finished_at, r.seconds])
                     .collect();

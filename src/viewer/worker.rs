@@ -30,17 +30,16 @@ pub struct Job {
     pub camera: CameraSpec,
     pub settings: RenderSettings,
     pub anti_aliasing: bool,
-    /// Render only a 1-sample pass at 1/`preview_divisor` of the resolution
-    /// (used while the user drags); 1 = the full progressive sequence.
-    pub preview_divisor: u32,
+    /// Render only a quick 1-sample pass (while the user drags), at
+    /// 1/`divisor` of the resolution and as simplified as the frame budget
+    /// chose; `None`: the full progressive sequence.
+    pub preview: Option<Preview>,
 }
 
 /// Which pass produced a buffer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PassKind {
-    Preview {
-        divisor: u32,
-    },
+    Preview(Preview),
     OneSample,
     SixteenSamples,
     /// The SPD protocol's one pass: rays through the pixel corners.
@@ -50,11 +49,39 @@ pub enum PassKind {
 impl PassKind {
     pub fn label(self) -> String {
         match self {
-            PassKind::Preview { divisor } => format!("preview 1/{divisor}"),
+            PassKind::Preview(p) => format!("preview {}", p.describe()),
             PassKind::OneSample => "1 sample".into(),
             PassKind::SixteenSamples => "16 samples".into(),
             PassKind::Corners => "SPD corners".into(),
         }
+    }
+}
+
+/// How a preview while moving simplifies the image to fit the frame budget.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Preview {
+    /// 1/`divisor` of the resolution on each axis.
+    pub divisor: u32,
+    /// Reflection and refraction rays (off: the eye ray only).
+    pub reflections: bool,
+    pub shadows: bool,
+}
+
+impl Preview {
+    /// E.g. "1/2, no reflections".
+    pub fn describe(&self) -> String {
+        let mut s = if self.divisor == 1 {
+            "full resolution".to_string()
+        } else {
+            format!("1/{}", self.divisor)
+        };
+        if !self.reflections {
+            s.push_str(", no reflections");
+        }
+        if !self.shadows {
+            s.push_str(", no shadows");
+        }
+        s
     }
 }
 
@@ -282,10 +309,8 @@ fn run(shared: Arc<Shared>, rx: Receiver<(u64, Job)>, threads: usize) {
 }
 
 fn render_job(shared: &Shared, generation: u64, job: &Job) {
-    let passes: Vec<PassKind> = if job.preview_divisor > 1 {
-        vec![PassKind::Preview {
-            divisor: job.preview_divisor,
-        }]
+    let passes: Vec<PassKind> = if let Some(preview) = job.preview {
+        vec![PassKind::Preview(preview)]
     } else if job.settings.corner_rays() {
         // The SPD protocol has one way to sample: no refinement pass.
         vec![PassKind::Corners]
@@ -302,9 +327,13 @@ fn render_job(shared: &Shared, generation: u64, job: &Job) {
         } else {
             1
         };
-        if let PassKind::Preview { divisor } = kind {
-            settings.width = (settings.width / divisor).max(1);
-            settings.height = (settings.height / divisor).max(1);
+        if let PassKind::Preview(p) = kind {
+            settings.width = (settings.width / p.divisor).max(1);
+            settings.height = (settings.height / p.divisor).max(1);
+            if !p.reflections {
+                settings.max_depth = 1;
+            }
+            settings.shadows = p.shadows;
         }
         if !render_pass(shared, generation, job, settings, kind, index == last) {
             return;
@@ -449,7 +478,7 @@ fn render_pass(
                 .map(|(_, f, _)| {
                     crate::render::image_error(&f.pixels, &frame.pixels, frame.colors)
                 }),
-            PassKind::Preview { .. } | PassKind::Corners => None,
+            PassKind::Preview(_) | PassKind::Corners => None,
         }
     };
     let frame = match (shown_view, kind) {

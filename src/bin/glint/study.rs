@@ -1,7 +1,7 @@
 //! `glint study`: how much accuracy each speed knob buys, measured.
 //!
 //! For each scene: anti-aliasing (1, 4, 16, 64 samples against a 256-sample
-//! reference), recursion depth (1 to 8 against 12), octree parameters, and
+//! reference; adaptive against the full 4x4 grid), recursion depth (1 to 8 against 12), octree parameters, and
 //! preview resolution (1/1, 1/2, 1/4 against the full-resolution image).
 //! Writes `DIR/study.md` and difference images `DIR/*.png`.
 
@@ -197,6 +197,50 @@ pub fn run(args: &StudyArgs) -> Result<()> {
             md,
             "\n![anti-aliasing need]({stem}-aa-need.png) — |1 sample − 16 samples| in sRGB, gain 4.\n"
         )?;
+
+        // Adaptive anti-aliasing against the full 4x4 grid.
+        let full = RenderSettings {
+            samples: 16,
+            adaptive: false,
+            ..base
+        };
+        let (t_full, f_full) = study.run(full, None)?;
+        let adaptive = RenderSettings {
+            adaptive: true,
+            ..full
+        };
+        let (t_adaptive, f_adaptive) = study.run(adaptive, None)?;
+        let refined = {
+            let renderer = Renderer::new(study.scene, &study.octree, adaptive)?;
+            study.pool.install(|| renderer.render(false, None).1).refined_pixels
+        };
+        let e = image_error(&f_adaptive.pixels, &f_full.pixels, base.colors);
+        let share = refined as f64 / (w as f64 * h as f64);
+        writeln!(md, "### Adaptive anti-aliasing (reference: the full 4x4 grid)\n")?;
+        writeln!(
+            md,
+            "| mode | time (s) | time vs full | pixels refined | PSNR displayed (dB) | pixels off by > 1/255 |"
+        )?;
+        writeln!(md, "|---|---:|---:|---:|---:|---:|")?;
+        writeln!(md, "| full | {t_full:.3} | 100% | 100% | inf | 0.0% |")?;
+        writeln!(
+            md,
+            "| adaptive | {t_adaptive:.3} | {:.0}% | {:.1}% | {:.1} | {:.1}% |\n",
+            100.0 * t_adaptive / t_full,
+            100.0 * share,
+            e.psnr_display,
+            100.0 * e.visible_fraction
+        )?;
+        summary.push((
+            stem.clone(),
+            "adaptive AA: time vs full, pixels refined, PSNR vs full".into(),
+            format!(
+                "{:.0}%, {:.1}%, {:.1} dB",
+                100.0 * t_adaptive / t_full,
+                100.0 * share,
+                e.psnr_display
+            ),
+        ));
 
         // Recursion depth.
         let deep = study.reference(RenderSettings {
