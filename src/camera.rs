@@ -44,6 +44,39 @@ pub struct Camera {
     pixel_size: f64,
 }
 
+impl CameraSpec {
+    /// Why the spec cannot make a camera, with which of its keys is at
+    /// fault (`eye`, `up` or `fov`), checked at load so errors can point
+    /// into the scene file.
+    pub fn check(&self) -> Result<(), (&'static str, String)> {
+        let back = self.eye - self.lookat;
+        let distance = back.length();
+        if !distance.is_finite() {
+            return Err((
+                "eye",
+                "eye and lookat are so far apart that their distance overflows".into(),
+            ));
+        }
+        if !(distance > 0.0) {
+            return Err(("eye", "eye and lookat coincide: no view direction".into()));
+        }
+        if !self.up.length().is_finite() {
+            return Err(("up", "the up vector's length overflows".into()));
+        }
+        match Camera::new(self, 1, 1) {
+            Err(CameraError::UpParallelToView) => Err((
+                "up",
+                "up is parallel to the view direction (or zero)".into(),
+            )),
+            Err(CameraError::FovOutOfRange(_)) => {
+                Err(("fov", "must lie strictly between 0 and 180 degrees".into()))
+            }
+            Err(e) => Err(("eye", e.to_string())),
+            Ok(_) => Ok(()),
+        }
+    }
+}
+
 impl Camera {
     pub fn new(spec: &CameraSpec, width: u32, height: u32) -> Result<Self, CameraError> {
         if !(spec.eye.is_finite() && spec.lookat.is_finite() && spec.up.is_finite())
@@ -64,7 +97,7 @@ impl Camera {
         }
         let w = back / back_len;
         let up_len = spec.up.length();
-        if !(up_len > 0.0) {
+        if !(up_len > 0.0 && up_len.is_finite()) {
             return Err(CameraError::UpParallelToView);
         }
         let side = (spec.up / up_len).cross(w);

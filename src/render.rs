@@ -19,6 +19,70 @@ pub use crate::settings::{AntiAliasing, Protocol, RenderSettings, Sides, ViewMod
 use crate::shapes::PreparedRay;
 use crate::stats::{Counter, NoCounts, RayCounts, WorkCounts};
 
+/// Most pixels an image may have (2^28: a 16384x16384 image), and most on
+/// a side: beyond these a typo would ask for gigabytes.
+pub const MAX_PIXELS: u64 = 1 << 28;
+pub const MAX_IMAGE_SIDE: u32 = 1 << 15;
+
+/// Memory a render of `settings` needs for its own buffers, in bytes: the
+/// frame (a `DVec3` a pixel, held twice while tiles are assembled), the
+/// encoded picture (3 bytes a pixel, twice while a PNG is built), and the
+/// extra frames of adaptive anti-aliasing, the aa-need view and the SPD
+/// protocol's corners. The scene and its octree come on top.
+pub fn estimated_bytes(settings: &RenderSettings) -> u64 {
+    let pixels = settings.width as u64 * settings.height as u64;
+    let mut per_pixel = 2 * 24 + 2 * 3;
+    if settings.anti_aliasing() == AntiAliasing::Adaptive {
+        per_pixel += 24 + 8 + 1 + 3;
+    }
+    if settings.view == ViewMode::AaNeed {
+        per_pixel += 2 * 24;
+    }
+    let corners = if settings.corner_rays() {
+        (settings.width as u64 + 1) * (settings.height as u64 + 1) * 24
+    } else {
+        0
+    };
+    pixels * per_pixel + corners
+}
+
+/// Memory this machine has available now (`MemAvailable` of
+/// `/proc/meminfo`), or `None` where that cannot be read.
+pub fn available_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+/// Refuses a render whose buffers (plus `other` bytes already held, such
+/// as the octree) would not fit in 80% of the available memory.
+pub fn check_memory(settings: &RenderSettings, other: u64) -> Result<(), RenderError> {
+    match available_memory() {
+        Some(available) => check_memory_against(settings, other, available),
+        None => Ok(()),
+    }
+}
+
+/// [`check_memory`] against a given amount of available memory.
+pub fn check_memory_against(
+    settings: &RenderSettings,
+    other: u64,
+    available: u64,
+) -> Result<(), RenderError> {
+    let needed = estimated_bytes(settings) + other;
+    let limit = available / 10 * 8;
+    if needed > limit {
+        return Err(RenderError::OutOfMemory {
+            width: settings.width,
+            height: settings.height,
+            needed,
+            available: limit,
+        });
+    }
+    Ok(())
+}
+
 /// Gain of the aa-need view: a difference of 1/4 shows at full brightness.
 pub const AA_NEED_GAIN: f64 = 4.0;
 
@@ -30,8 +94,24 @@ pub enum RenderError {
     Samples(u32),
     #[error("max depth must be at least 1, got {0}")]
     MaxDepth(u32),
-    #[error("image of {0}x{1} pixels is too large")]
+    #[error(
+        "an image of {0}x{1} pixels is too large: glint renders at most {max} pixels ({side} on a side)",
+        max = MAX_PIXELS,
+        side = MAX_IMAGE_SIDE
+    )]
     TooLarge(u32, u32),
+    #[error(
+        "a {width}x{height} render needs about {need} MiB of memory, more than the {limit} MiB \
+         this machine has available: choose a smaller image",
+        need = needed / (1 << 20),
+        limit = available / (1 << 20)
+    )]
+    OutOfMemory {
+        width: u32,
+        height: u32,
+        needed: u64,
+        available: u64,
+    },
 }
 
 /// A rendered image: linear RGB for [`ViewMode::Shaded`] and
@@ -155,7 +235,9 @@ impl<'a> Renderer<'a> {
         if settings.max_depth == 0 {
             return Err(RenderError::MaxDepth(settings.max_depth));
         }
-        if settings.width as u64 * settings.height as u64 > 1 << 28 {
+        if settings.width as u64 * settings.height as u64 > MAX_PIXELS
+            || settings.width.max(settings.height) > MAX_IMAGE_SIDE
+        {
             return Err(RenderError::TooLarge(settings.width, settings.height));
         }
         let camera = Camera::new(camera, settings.width, settings.height)?;

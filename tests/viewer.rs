@@ -500,5 +500,8 @@ fn a_budget_preview_drops_what_it_says() {
     assert_eq!(r.kind, PassKind::Preview(preview));
     assert_eq!((r.width, r.height), (48, 36));
     assert_eq!(r.rays.primary, 48 * 36);
-    assert_eq!((r.rays.shadow, r.rays.reflection, r.rays.refraction), (0, 0, 0));
+    assert_eq!(
+        (r.rays.shadow, r.rays.reflection, r.rays.refraction),
+        (0, 0, 0)
+    );
 }

@@ -258,12 +258,16 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 }
                 image.width = w as u32;
                 image.height = h as u32;
-                camera = Some(CameraSpec {
+                let spec = CameraSpec {
                     eye,
                     lookat,
                     up,
                     fov: fov_from_nff_angle(angle, h as u32),
-                });
+                };
+                if let Err((_, message)) = spec.check() {
+                    return Err(tokens.error_at(line, column, "v", message));
+                }
+                camera = Some(spec);
             }
             "b" => image.background = tokens.color_in("background colour", &UNIT_RANGE)?,
             "l" => {

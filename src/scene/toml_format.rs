@@ -203,10 +203,36 @@ pub const MAX_DEPTH_LIMIT: i64 = 64;
 
 pub fn parse(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, SceneError> {
     let cx = Context { text, path };
-    let file: SceneFile = toml::from_str(text).map_err(|e| {
-        let span = e.span().unwrap_or(0..0);
-        let key = key_at(text, span.start);
-        cx.error(span, &key, e.message().trim().to_owned())
+    // Syntax errors have a place but no key; type errors get their key path
+    // (`objects[0].radius`, the style of every other error) from
+    // serde_path_to_error and their place from toml's span.
+    let de = toml::de::Deserializer::parse(text).map_err(|e| {
+        cx.error(
+            e.span().unwrap_or(0..0),
+            "(syntax)",
+            e.message().trim().to_owned(),
+        )
+    })?;
+    let file: SceneFile = serde_path_to_error::deserialize(de).map_err(|e| {
+        // `Spanned` values add a private segment to the path: drop it.
+        let path = e
+            .path()
+            .to_string()
+            .split(".$__")
+            .next()
+            .unwrap_or_default()
+            .to_string();
+        let inner = e.into_inner();
+        let key = if path == "." {
+            "(top level)".to_string()
+        } else {
+            path
+        };
+        cx.error(
+            inner.span().unwrap_or(0..0),
+            &key,
+            inner.message().trim().to_owned(),
+        )
     })?;
 
     let camera = CameraSpec {
@@ -215,12 +241,13 @@ pub fn parse(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, S
         up: cx.vec3(&file.camera.up, "camera.up")?,
         fov: cx.finite(&file.camera.fov, "camera.fov")?,
     };
-    if !(camera.fov > 0.0 && camera.fov < 180.0) {
-        return Err(cx.error(
-            file.camera.fov.span(),
-            "camera.fov",
-            "must lie strictly between 0 and 180 degrees",
-        ));
+    if let Err((key, message)) = camera.check() {
+        let span = match key {
+            "up" => file.camera.up.span(),
+            "fov" => file.camera.fov.span(),
+            _ => file.camera.eye.span(),
+        };
+        return Err(cx.error(span, &format!("camera.{key}"), message));
     }
 
     let mut image = ImageSettings::default();
@@ -559,60 +586,6 @@ fn add_object(
     Ok(())
 }
 
-/// The dotted key path at a byte offset, found from the table header and the
-/// `key =` before it (toml reports spans, not keys).
-fn key_at(text: &str, offset: usize) -> String {
-    let offset = text.floor_char_boundary(offset.min(text.len()));
-    let before = &text[..offset];
-    let mut table = String::new();
-    let mut key = String::new();
-    for line in before.lines() {
-        let l = line.trim();
-        if l.starts_with('[') {
-            table = l.trim_matches(|c| c == '[' || c == ']').trim().to_owned();
-            key.clear();
-        } else if let Some((k, _)) = l.split_once('=') {
-            key = k.trim().to_owned();
-        }
-    }
-    // A span that starts at a key (an unknown field) names that key.
-    let rest = &text[offset..];
-    let ident_len = rest
-        .find(|c: char| !(c.is_alphanumeric() || c == '_' || c == '-'))
-        .unwrap_or(rest.len());
-    let at_line_start = before
-        .rsplit('\n')
-        .next()
-        .is_none_or(|l| l.trim().is_empty());
-    if at_line_start && rest.starts_with('[') {
-        let header = rest.lines().next().unwrap_or("");
-        return header
-            .trim()
-            .trim_matches(|c| c == '[' || c == ']')
-            .trim()
-            .to_owned();
-    }
-    if ident_len > 0 && rest[ident_len..].trim_start().starts_with('=') {
-        key = rest[..ident_len].to_owned();
-    } else if let Some(eq) = before.rfind('=') {
-        // Inside an inline table the innermost `key =` is the one at fault.
-        let head = &before[..eq];
-        let start = head
-            .rfind(|c: char| c == '{' || c == ',' || c == '\n')
-            .map_or(0, |i| i + 1);
-        let inner = head[start..].trim();
-        if !inner.is_empty() && !inner.contains(['[', ']']) {
-            key = inner.to_owned();
-        }
-    }
-    match (table.is_empty(), key.is_empty()) {
-        (true, true) => "(top level)".into(),
-        (true, false) => key,
-        (false, true) => table,
-        (false, false) => format!("{table}.{key}"),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -674,12 +647,12 @@ radius = 1
             (
                 "radius = 1",
                 "radius = \"big\"",
-                "test.toml:18:10: `objects.radius`",
+                "test.toml:18:10: `objects[0].radius`: invalid type",
             ),
             (
                 "radius = 1",
                 "radius = 1\nsize = 3",
-                "test.toml:19:1: `objects.size`",
+                "test.toml:19:1: `objects[0].size`: unknown field `size`",
             ),
             (
                 "material = \"red\"",
@@ -692,6 +665,21 @@ radius = 1
                 "test.toml:15:8: `objects[0].kind`: unknown kind",
             ),
             ("fov = 45", "fov = 180", "test.toml:6:7: `camera.fov`"),
+            (
+                "eye = [0, 0, 5]",
+                "eye = [1e300, 1.5, 6]",
+                "test.toml:3:7: `camera.eye`: eye and lookat are so far apart that their distance overflows",
+            ),
+            (
+                "eye = [0, 0, 5]",
+                "eye = [0, 0, 0]",
+                "test.toml:3:7: `camera.eye`: eye and lookat coincide",
+            ),
+            (
+                "up = [0, 1, 0]",
+                "up = [0, 0, 2]",
+                "test.toml:5:6: `camera.up`: up is parallel to the view direction",
+            ),
             (
                 "fov = 45",
                 "fov = inf",

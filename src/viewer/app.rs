@@ -126,6 +126,7 @@ pub struct GlintApp {
     pub(crate) dragging: bool,
     /// Target time of a preview pass while the user drags (milliseconds).
     pub(crate) frame_budget_ms: f64,
+    asked_focus: bool,
     /// What the budget chose for the last drag, and its estimated seconds.
     pub(crate) last_preview: Option<(Preview, f64)>,
     pub(crate) messages: Vec<Message>,
@@ -201,6 +202,7 @@ impl GlintApp {
             dragging: false,
             frame_budget_ms: 33.0,
             last_preview: None,
+            asked_focus: false,
             messages: Vec::new(),
             commands: Vec::new(),
             frames_since_final: 0,
@@ -523,17 +525,15 @@ impl GlintApp {
                 None => return,
             }
         } else {
-            let p = PathBuf::from(&default_name);
-            self.say(
-                format!(
-                    "no file dialog available; exporting to the current directory as {default_name}"
-                ),
-                false,
-            );
-            p
+            // No dialog (no desktop portal, e.g. under Xvfb): a place made
+            // for pictures, never the working directory (often a checkout).
+            export_dir(&self.source).join(&default_name)
         };
         match self.export_to(&path) {
-            Ok(()) => self.say(format!("exported {}", path.display()), false),
+            Ok(()) => {
+                let shown = std::path::absolute(&path).unwrap_or(path);
+                self.say(format!("exported {}", shown.display()), false)
+            }
             Err(e) => self.say(format!("export to {} failed: {e:#}", path.display()), true),
         }
     }
@@ -692,17 +692,25 @@ impl GlintApp {
     /// One frame of the viewer: drawn into `ui`, which covers the window.
     pub fn frame_ui(&mut self, ui: &mut egui::Ui) {
         let ctx = ui.ctx().clone();
+        if !self.asked_focus {
+            // Keys (R, Ctrl+S) work only in a focused window, and some
+            // window managers focus a new window only when clicked.
+            ctx.send_viewport_cmd(egui::ViewportCommand::Focus);
+            self.asked_focus = true;
+        }
         self.update_texture(&ctx);
         self.shortcuts(&ctx);
         egui::Panel::top("menu").show(ui, |ui| super::panels::menu_ui(self, ui));
         egui::Panel::bottom("status").show(ui, |ui| super::panels::status_ui(self, ui));
+        // Fixed widths: rows appearing (the RMSE, a ray tree) must not
+        // widen a panel and shrink the image.
         egui::Panel::left("controls")
-            .resizable(true)
-            .default_size(300.0)
+            .resizable(false)
+            .exact_size(330.0)
             .show(ui, |ui| super::panels::controls_ui(self, ui));
         egui::Panel::right("timing")
-            .resizable(true)
-            .default_size(300.0)
+            .resizable(false)
+            .exact_size(330.0)
             .show(ui, |ui| super::panels::timing_ui(self, ui));
         egui::CentralPanel::default_margins().show(ui, |ui| self.image_ui(ui));
         self.apply_commands(&ctx);
@@ -787,12 +795,68 @@ fn file_dialog_available() -> bool {
     std::env::var_os("DBUS_SESSION_BUS_ADDRESS").is_some_and(|v| !v.is_empty())
 }
 
-/// Local-time-free timestamp for file names: seconds since the Unix epoch.
+/// A readable UTC timestamp for file names, e.g. `2026-11-23T14-05-09Z`.
 fn timestamp() -> String {
     let secs = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0, |d| d.as_secs());
-    format!("{secs}")
+    utc_timestamp(secs)
+}
+
+/// `secs` since the Unix epoch as `YYYY-MM-DDTHH-MM-SSZ` (dashes, not
+/// colons, so the name is valid everywhere). The date from the day count
+/// follows Hinnant's `civil_from_days` ("chrono-Compatible Low-Level Date
+/// Algorithms").
+fn utc_timestamp(secs: u64) -> String {
+    let days = (secs / 86_400) as i64;
+    let rem = secs % 86_400;
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1_460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + (month <= 2) as i64;
+    format!(
+        "{year:04}-{month:02}-{day:02}T{:02}-{:02}-{:02}Z",
+        rem / 3600,
+        rem / 60 % 60,
+        rem % 60
+    )
+}
+
+/// Where exports go without a file dialog: the user's pictures directory
+/// (`XDG_PICTURES_DIR`, from the environment or `~/.config/user-dirs.dirs`,
+/// else `~/Pictures`) if it exists, else the scene file's directory, else
+/// the temporary directory.
+fn export_dir(source: &SceneSource) -> PathBuf {
+    let home = std::env::var_os("HOME").map(PathBuf::from);
+    let from_user_dirs = || {
+        let home = home.as_ref()?;
+        let text = std::fs::read_to_string(home.join(".config/user-dirs.dirs")).ok()?;
+        let line = text
+            .lines()
+            .find(|l| l.trim_start().starts_with("XDG_PICTURES_DIR="))?;
+        let value = line.split_once('=')?.1.trim().trim_matches('"');
+        Some(PathBuf::from(
+            value.replace("$HOME", &home.to_string_lossy()),
+        ))
+    };
+    let pictures = std::env::var_os("XDG_PICTURES_DIR")
+        .map(PathBuf::from)
+        .or_else(from_user_dirs)
+        .or_else(|| home.as_ref().map(|h| h.join("Pictures")));
+    if let Some(dir) = pictures.filter(|d| d.is_dir()) {
+        return dir;
+    }
+    if let SceneSource::File(p) = source
+        && let Some(dir) = p.parent().filter(|d| d.is_dir())
+    {
+        return std::path::absolute(dir).unwrap_or_else(|_| dir.to_owned());
+    }
+    std::env::temp_dir()
 }
 
 /// Estimated seconds of `preview` at the current settings, from the full
@@ -848,7 +912,18 @@ mod tests {
             finished_at: 1.0,
             one_sample_error: None,
             refined_pixels: None,
+            view: crate::render::ViewMode::Shaded,
+            max_depth: 5,
+            protocol: crate::render::Protocol::Glint,
         }
+    }
+
+    #[test]
+    fn timestamps_are_readable_utc() {
+        assert_eq!(utc_timestamp(0), "1970-01-01T00-00-00Z");
+        // 2000-02-29 (a leap day) 12:34:56 and 2026-11-23 14:05:09.
+        assert_eq!(utc_timestamp(951_827_696), "2000-02-29T12-34-56Z");
+        assert_eq!(utc_timestamp(1_795_442_709), "2026-11-23T14-05-09Z");
     }
 
     #[test]

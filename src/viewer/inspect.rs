@@ -632,7 +632,7 @@ pub fn inspect_controls_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                 } else {
                     ui.visuals().text_color()
                 };
-                ui.label(egui::RichText::new(text).color(color).strong());
+                ui.add(egui::Label::new(egui::RichText::new(text).color(color).strong()).wrap());
             }
             None => {
                 ui.label("B is rendering (or has another size)…");

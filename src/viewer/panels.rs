@@ -171,7 +171,7 @@ pub fn controls_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                     ui.label("x");
                     ui.add(DragValue::new(&mut app.settings.height).range(1..=8192));
                 });
-                ui.horizontal(|ui| {
+                ui.horizontal_wrapped(|ui| {
                     ui.label("View");
                     for v in ViewMode::ALL {
                         ui.selectable_value(&mut app.settings.view, v, v.name());
@@ -304,60 +304,84 @@ fn legend_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
 fn timing_grid_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
     let history = app.worker().history();
     ui.heading("Timing");
-    let last = |kind: PassKind| history.iter().rev().find(|r| r.kind == kind);
+    // Figures compare passes of one image only: those of the newest
+    // generation that has a full pass (a preview is not one), so a toggle
+    // never shows a new 1-sample time against an old 16-sample time.
+    let shown = history
+        .iter()
+        .rev()
+        .find(|r| !matches!(r.kind, PassKind::Preview(_)))
+        .map(|r| r.generation);
+    let of_shown = |kind: PassKind| {
+        history
+            .iter()
+            .rev()
+            .find(|r| Some(r.generation) == shown && r.kind == kind)
+    };
+    let rendering = app.worker().generation() != shown.unwrap_or(0);
     egui::Grid::new("timing-grid")
         .num_columns(2)
+        .max_col_width(170.0)
         .striped(true)
         .show(ui, |ui| {
+            // Values wrap rather than widen the (fixed-width) panel.
             let mut row = |label: &str, value: String| {
                 ui.label(label);
-                ui.label(value);
+                ui.add(egui::Label::new(value).wrap());
                 ui.end_row();
             };
-            if let Some(r) = last(PassKind::Corners) {
+            let pending = if rendering { "rendering…" } else { "–" };
+            if let Some(r) = of_shown(PassKind::Corners) {
                 row("SPD corner pass", format!("{:.3} s", r.seconds));
-            }
-            match last(PassKind::OneSample) {
-                Some(r) => row("1-sample pass", format!("{:.3} s", r.seconds)),
-                None => row("1-sample pass", "–".into()),
-            }
-            match last(PassKind::SixteenSamples) {
-                Some(r) => row("16-sample pass", format!("{:.3} s", r.seconds)),
-                None => row("16-sample pass", "–".into()),
-            }
-            if let Some(r) = last(PassKind::SixteenSamples)
-                && let Some(refined) = r.refined_pixels
-            {
+            } else {
+                let one = of_shown(PassKind::OneSample);
+                let sixteen = of_shown(PassKind::SixteenSamples);
                 row(
-                    "refined (adaptive)",
-                    format!(
-                        "{:.1}% of pixels",
-                        100.0 * refined as f64 / (r.width as f64 * r.height as f64).max(1.0)
-                    ),
+                    "1-sample pass",
+                    one.map_or(pending.into(), |r| format!("{:.3} s", r.seconds)),
                 );
-            }
-            if let (Some(a), Some(b)) = (last(PassKind::OneSample), last(PassKind::SixteenSamples))
-            {
-                row(
-                    "16 / 1 time ratio",
-                    format!("{:.1}x", b.seconds / a.seconds.max(1e-9)),
-                );
-                if let Some(e) = b.one_sample_error {
+                if app.anti_aliasing() || sixteen.is_some() {
                     row(
-                        "1-sample error vs 16",
+                        "16-sample pass",
+                        sixteen.map_or(pending.into(), |r| format!("{:.3} s", r.seconds)),
+                    );
+                }
+                if let Some(r) = sixteen
+                    && let Some(refined) = r.refined_pixels
+                {
+                    row(
+                        "refined (adaptive)",
                         format!(
-                            "RMSE {:.4}, PSNR {:.1} dB (displayed)",
-                            e.rmse_display, e.psnr_display
+                            "{:.1}% of pixels",
+                            100.0 * refined as f64 / (r.width as f64 * r.height as f64).max(1.0)
                         ),
                     );
+                }
+                if let (Some(a), Some(b)) = (one, sixteen) {
                     row(
-                        "pixels AA changes",
-                        format!("{:.1}% (> 1/255)", 100.0 * e.visible_fraction),
+                        "16 / 1 time ratio",
+                        format!("{:.1}x", b.seconds / a.seconds.max(1e-9)),
                     );
+                    // An error of pictures: not of depth, normals or costs.
+                    if b.view == ViewMode::Shaded
+                        && let Some(e) = b.one_sample_error
+                    {
+                        row(
+                            "1-sample error vs 16",
+                            format!("RMSE {:.4}, {:.1} dB", e.rmse_display, e.psnr_display),
+                        );
+                        row(
+                            "pixels AA changes",
+                            format!("{:.1}% (> 1/255)", 100.0 * e.visible_fraction),
+                        );
+                    }
                 }
             }
             if let Some((p, estimate)) = app.last_preview {
-                let measured = history.iter().rev().find(|r| r.kind == PassKind::Preview(p));
+                let measured = history
+                    .iter()
+                    .rev()
+                    .find(|r| r.kind == PassKind::Preview(p));
                 row(
                     "while moving",
                     match measured {
@@ -372,7 +396,7 @@ fn timing_grid_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                     },
                 );
             }
-            if let Some(r) = history.last() {
+            if let Some(r) = history.iter().rev().find(|r| Some(r.generation) == shown) {
                 row(
                     "Mrays/s (last pass)",
                     format!("{:.2}", r.rays.total() as f64 / r.seconds.max(1e-9) / 1e6),
@@ -395,9 +419,27 @@ fn timing_grid_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
             row("shapes", format!("{}", app.scene.shapes.len()));
         });
     ui.separator();
-    ui.label("Pass times this session (s)");
-    // One series per combination of the toggles, so each toggle's effect
-    // shows as a jump between series.
+    pass_plot_ui(&history, ui);
+}
+
+/// The round number (1, 2 or 5 times a power of ten) nearest above `x`.
+fn round_step(x: f64) -> f64 {
+    if !(x > 0.0) {
+        return 1.0;
+    }
+    let power = 10f64.powf(x.log10().floor());
+    [1.0, 2.0, 5.0, 10.0]
+        .into_iter()
+        .map(|m| m * power)
+        .find(|&s| s >= x)
+        .unwrap_or(10.0 * power)
+}
+
+/// Every full pass of the session, one series per octree and anti-aliasing
+/// setting so each toggle shows as a jump between series, on a logarithmic
+/// time axis (a 100 s pass with the octree off must not flatten the rest).
+fn pass_plot_ui(history: &[crate::viewer::worker::PassRecord], ui: &mut egui::Ui) {
+    ui.label("Pass times this session (log scale)");
     let series = [
         (
             true,
@@ -424,23 +466,65 @@ fn timing_grid_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
             Color32::from_rgb(230, 190, 60),
         ),
     ];
+    let full: Vec<_> = history
+        .iter()
+        .filter(|r| !matches!(r.kind, PassKind::Preview(_)))
+        .collect();
+    let log = |s: f64| s.max(1e-4).log10();
+    // Whole decades around the data, so the axis always shows at least two
+    // labelled ticks; the time axis starts at 0 and reaches past the newest
+    // point, leaving room on the left for the legend.
+    let (lo, hi) = full
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), r| {
+            (lo.min(log(r.seconds)), hi.max(log(r.seconds)))
+        });
+    let (lo, hi) = if lo.is_finite() {
+        (lo.floor(), hi.ceil().max(lo.floor() + 1.0))
+    } else {
+        (-2.0, 0.0)
+    };
+    let newest = full.iter().map(|r| r.finished_at).fold(1.0f64, f64::max);
     Plot::new("pass-times")
-        .height(180.0)
-        .legend(Legend::default())
+        .height(190.0)
+        .legend(Legend::default().position(egui_plot::Corner::LeftTop))
         .allow_drag(false)
         .allow_zoom(false)
         .allow_scroll(false)
+        .include_y(lo)
+        .include_y(hi + 0.6)
+        .include_x(-0.35 * newest)
+        .include_x(newest * 1.05)
         .x_axis_label("session time (s)")
+        // Labelled ticks at a round step, about five across the axis.
+        .x_grid_spacer(egui_plot::uniform_grid_spacer(|input| {
+            let step = round_step((input.bounds.1 - input.bounds.0) / 5.0);
+            [step, step, step]
+        }))
+        .y_grid_spacer(egui_plot::uniform_grid_spacer(|_| [1.0, 1.0, 1.0]))
+        .y_axis_formatter(|mark, _| {
+            let seconds = 10f64.powf(mark.value);
+            if seconds < 1.0 {
+                format!("{:.0} ms", seconds * 1000.0)
+            } else {
+                format!("{seconds:.0} s")
+            }
+        })
+        .x_axis_formatter(|mark, _| {
+            if mark.value < 0.0 {
+                String::new()
+            } else {
+                format!("{:.0}", mark.value)
+            }
+        })
         .show(ui, |plot| {
             for (octree, sixteen, name, color) in series {
-                let points: Vec<[f64; 2]> = history
+                let points: Vec<[f64; 2]> = full
                     .iter()
                     .filter(|r| {
-                        r.octree == octree
-                            && (r.kind == PassKind::SixteenSamples) == sixteen
-                            && !matches!(r.kind, PassKind::Preview(_))
+                        r.octree == octree && (r.kind == PassKind::SixteenSamples) == sixteen
                     })
-                    .map(|r| [r.finished_at, r.seconds])
+                    .map(|r| [r.finished_at, log(r.seconds)])
                     .collect();
                 if !points.is_empty() {
                     plot.line(Line::new(name, points.clone()).color(color));

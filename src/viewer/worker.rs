@@ -104,6 +104,11 @@ pub struct PassRecord {
     /// For an adaptive 16-sample pass: the pixels it refined (the rest kept
     /// their 1-sample value).
     pub refined_pixels: Option<u64>,
+    /// What the pass showed, and the settings that decide its time apart
+    /// from anti-aliasing (passes are compared only when these agree).
+    pub view: crate::render::ViewMode,
+    pub max_depth: u32,
+    pub protocol: crate::render::Protocol,
 }
 
 /// The display buffer: RGBA8, exactly what the viewer shows and exports.
@@ -363,35 +368,37 @@ fn render_pass(
     };
     let (w, h) = (settings.width, settings.height);
     let all = tiles(w, h);
+    // A preview is shown only once complete (a half-swept preview is a torn
+    // frame), with its record; a full pass sweeps in over the previous
+    // image, first scaled to the new size if it differs (after a preview).
+    let preview = matches!(kind, PassKind::Preview(_));
+    // The aa-need difference exists only after a 16-sample pass; before
+    // it (and without anti-aliasing) the frame is the shaded picture.
+    let frame_view = if shown_view == ViewMode::AaNeed && kind != PassKind::SixteenSamples {
+        ViewMode::Shaded
+    } else {
+        shown_view
+    };
+    let source = FrameSource {
+        scene: Arc::clone(&job.scene),
+        camera: job.camera,
+        settings: RenderSettings {
+            view: frame_view,
+            ..settings
+        },
+    };
     {
         let mut b = shared.buffer.lock().unwrap_or_else(|e| e.into_inner());
-        // A new image size starts from black; otherwise the previous pass
-        // stays visible under the tiles that sweep in.
-        if b.width != w || b.height != h || b.rgba.len() != (w * h * 4) as usize {
+        if !preview && (b.width != w || b.height != h || b.rgba.len() != (w * h * 4) as usize) {
+            b.rgba = resample_rgba(&b.rgba, b.width, b.height, w, h);
             b.width = w;
             b.height = h;
-            b.rgba = vec![0; (w * h * 4) as usize];
-            for px in b.rgba.chunks_exact_mut(4) {
-                px[3] = 255;
-            }
         }
         b.generation = generation;
         b.pass = Some(kind);
-        // The aa-need difference exists only after a 16-sample pass; before
-        // it (and without anti-aliasing) the frame is the shaded picture.
-        let frame_view = if shown_view == ViewMode::AaNeed && kind != PassKind::SixteenSamples {
-            ViewMode::Shaded
-        } else {
-            shown_view
-        };
-        b.source = Some(FrameSource {
-            scene: Arc::clone(&job.scene),
-            camera: job.camera,
-            settings: RenderSettings {
-                view: frame_view,
-                ..settings
-            },
-        });
+        if !preview {
+            b.source = Some(source.clone());
+        }
         b.tiles_done = 0;
         b.tiles_total = all.len() as u64;
         b.finished = false;
@@ -439,7 +446,7 @@ fn render_pass(
                 None => renderer.render_tile(tile, false),
             };
             let rgba = tile_rgba(&values, &settings, &depth_range);
-            {
+            if !matches!(kind, PassKind::Preview(_)) {
                 let mut b = shared.buffer.lock().unwrap_or_else(|e| e.into_inner());
                 if b.generation == generation && b.width == w {
                     for row in 0..tile.height {
@@ -500,6 +507,9 @@ fn render_pass(
             return false;
         }
         b.rgba = rgba;
+        b.width = w;
+        b.height = h;
+        b.source = Some(source);
         b.finished = last;
         b.last_frame = Some(frame);
         b.version += 1;
@@ -517,6 +527,9 @@ fn render_pass(
             finished_at: shared.started.elapsed().as_secs_f64(),
             one_sample_error,
             refined_pixels: first_pass.is_some().then_some(counts.refined_pixels),
+            view: shown_view,
+            max_depth: settings.max_depth,
+            protocol: settings.protocol,
         });
     }
     (shared.repaint)();
@@ -593,6 +606,27 @@ fn tile_rgba(
         .to_rgb8(),
     };
     rgb_to_rgba(&rgb)
+}
+
+/// An RGBA image scaled to `w x h` by nearest neighbour (opaque black when
+/// there is nothing to scale).
+fn resample_rgba(rgba: &[u8], from_w: u32, from_h: u32, w: u32, h: u32) -> Vec<u8> {
+    let mut out = vec![0u8; (w * h * 4) as usize];
+    let usable = from_w > 0 && from_h > 0 && rgba.len() == (from_w * from_h * 4) as usize;
+    for y in 0..h {
+        for x in 0..w {
+            let dst = ((y * w + x) * 4) as usize;
+            if usable {
+                let sx = (x as u64 * from_w as u64 / w as u64) as u32;
+                let sy = (y as u64 * from_h as u64 / h as u64) as u32;
+                let src = ((sy * from_w + sx) * 4) as usize;
+                out[dst..dst + 4].copy_from_slice(&rgba[src..src + 4]);
+            } else {
+                out[dst + 3] = 255;
+            }
+        }
+    }
+    out
 }
 
 pub fn rgb_to_rgba(rgb: &[u8]) -> Vec<u8> {

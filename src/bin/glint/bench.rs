@@ -37,7 +37,7 @@ pub struct BenchArgs {
     pub repeat: u32,
     #[command(flatten)]
     pub octree_params: OctreeArgs,
-    /// Render threads (default: one per core).
+    /// Render threads (default: one per core; at most 8 per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
     /// Output format.

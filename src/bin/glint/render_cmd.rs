@@ -20,13 +20,18 @@ pub struct RenderArgs {
     /// Scene file (.toml or .nff); not given with --from-png.
     #[arg(required_unless_present = "from_png", conflicts_with = "from_png")]
     pub scene: Option<PathBuf>,
-    /// Output PNG file (not needed with --trace-pixel).
+    /// Output PNG (not needed with --trace-pixel): a `.png` file, written
+    /// through a temporary file renamed into place (through symbolic links
+    /// to their target); `-` for standard output; FIFOs and devices are
+    /// written directly. The scene being rendered is never overwritten.
     #[arg(short, long, required_unless_present = "trace_pixel")]
     pub output: Option<PathBuf>,
-    /// Image width in pixels (default: the scene's).
+    /// Image width in pixels (default: the scene's). At most 32768 a side,
+    /// 268,435,456 pixels in all, and what fits in 80% of the available
+    /// memory (the estimate is checked before rendering).
     #[arg(long, value_parser = parse_positive)]
     pub width: Option<u32>,
-    /// Image height in pixels (default: the scene's).
+    /// Image height in pixels (default: the scene's); limits as for --width.
     #[arg(long, value_parser = parse_positive)]
     pub height: Option<u32>,
     /// Rays per pixel: 1 (pixel centre) or 16 (regular 4x4 grid); the SPD
@@ -49,7 +54,7 @@ pub struct RenderArgs {
     pub octree: Option<Switch>,
     #[command(flatten)]
     pub octree_params: OctreeArgs,
-    /// Render threads (default: one per core).
+    /// Render threads (default: one per core; at most 8 per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
     /// What the image shows: shaded, normals, depth, cost (intersection
@@ -57,6 +62,10 @@ pub struct RenderArgs {
     /// (|1 − 16 samples|). Default: shaded, or the recorded view with --from-png.
     #[arg(long, value_parser = |s: &str| s.parse::<ViewMode>())]
     pub view: Option<ViewMode>,
+    /// Say nothing on success (otherwise one line on stderr: the file
+    /// written, its size, the render time).
+    #[arg(long, short)]
+    pub quiet: bool,
     /// Print one JSON object of statistics on stdout.
     #[arg(long)]
     pub stats: bool,
@@ -65,7 +74,7 @@ pub struct RenderArgs {
     #[arg(long, value_name = "OLD.png")]
     pub from_png: Option<PathBuf>,
     /// Print the tree of rays that pixel X,Y's centre ray spawns as one JSON
-    /// object on stdout, and render nothing else. X counts from the left,
+    /// object on stdout; with -o the image is rendered and written too. X counts from the left,
     /// Y from the top, both from 0.
     #[arg(long, value_name = "X,Y", value_parser = parse_pixel)]
     pub trace_pixel: Option<(u32, u32)>,
@@ -166,6 +175,18 @@ struct RaysJson {
 
 pub fn run(args: &RenderArgs) -> Result<()> {
     args.rules.check(args.max_depth, args.samples)?;
+    // Check the output before any work: its name, and that it is not an input.
+    if let Some(output) = &args.output {
+        let input = args.scene.as_deref().or(args.from_png.as_deref());
+        let target = glint::export::check_output(output, input)?;
+        if target == glint::export::OutputTarget::Stdout {
+            anyhow::ensure!(
+                !args.stats && args.trace_pixel.is_none(),
+                "-o - writes the PNG to standard output, where --stats and --trace-pixel \
+                 print their JSON: write the image to a file"
+            );
+        }
+    }
     let load_start = Instant::now();
     let mut overlay_depth = args.overlay.map(|_| args.overlay_depth.unwrap_or(4));
     let (mut scene, scene_name, mut settings, camera) = match (&args.from_png, &args.scene) {
@@ -236,13 +257,19 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let build_s = build_start.elapsed().as_secs_f64();
 
     if let Some((x, y)) = args.trace_pixel {
-        return print_ray_tree(&scene, &scene_name, &octree, settings, &camera, x, y);
+        print_ray_tree(&scene, &scene_name, &octree, settings, &camera, x, y)?;
     }
+    // With --trace-pixel alone the tree is all there is to do.
     let Some(output) = &args.output else {
+        if args.trace_pixel.is_some() {
+            return Ok(());
+        }
         anyhow::bail!("give an output file with -o");
     };
     // Validate before starting (the aa-need view renders twice).
     Renderer::with_camera(&scene, &octree, settings, &camera)
+        .with_context(|| format!("cannot render {scene_name}"))?;
+    glint::render::check_memory(&settings, octree.stats().memory_bytes)
         .with_context(|| format!("cannot render {scene_name}"))?;
     let bar = std::io::stderr().is_terminal().then(|| {
         let bar = indicatif::ProgressBar::new(1);
@@ -286,6 +313,25 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             glint::export::save_rgb_png(output, frame.width, height, &rgb, Some(&record))?;
         }
         None => glint::export::save_png(&frame, output, Some(&record))?,
+    }
+    if !args.quiet {
+        let written = match glint::export::OutputTarget::resolve(output)? {
+            glint::export::OutputTarget::File(p) => std::fs::metadata(&p)
+                .map(|m| format!(", {} KiB", m.len().div_ceil(1024)))
+                .unwrap_or_default(),
+            _ => String::new(),
+        };
+        eprintln!(
+            "wrote {} ({}x{}{written}) in {:.2} s",
+            if output.as_os_str() == "-" {
+                "standard output".to_string()
+            } else {
+                output.display().to_string()
+            },
+            frame.width,
+            frame.height,
+            render_s
+        );
     }
 
     if scene.dropped_triangles > 0 {

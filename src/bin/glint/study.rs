@@ -31,7 +31,7 @@ pub struct StudyArgs {
     /// Timed runs per configuration (the median is reported).
     #[arg(long, default_value_t = 3, value_parser = parse_positive)]
     pub repeat: u32,
-    /// Render threads (default: one per core).
+    /// Render threads (default: one per core; at most 8 per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
 }
@@ -212,11 +212,17 @@ pub fn run(args: &StudyArgs) -> Result<()> {
         let (t_adaptive, f_adaptive) = study.run(adaptive, None)?;
         let refined = {
             let renderer = Renderer::new(study.scene, &study.octree, adaptive)?;
-            study.pool.install(|| renderer.render(false, None).1).refined_pixels
+            study
+                .pool
+                .install(|| renderer.render(false, None).1)
+                .refined_pixels
         };
         let e = image_error(&f_adaptive.pixels, &f_full.pixels, base.colors);
         let share = refined as f64 / (w as f64 * h as f64);
-        writeln!(md, "### Adaptive anti-aliasing (reference: the full 4x4 grid)\n")?;
+        writeln!(
+            md,
+            "### Adaptive anti-aliasing (reference: the full 4x4 grid)\n"
+        )?;
         writeln!(
             md,
             "| mode | time (s) | time vs full | pixels refined | PSNR displayed (dB) | pixels off by > 1/255 |"

@@ -33,7 +33,7 @@ pub struct ViewArgs {
     /// Image size as WIDTHxHEIGHT (default: the scene's).
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
-    /// Render threads (default: one per core).
+    /// Render threads (default: one per core; at most 8 per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
     /// Window size as WIDTHxHEIGHT in points.
@@ -85,6 +85,7 @@ impl Default for ViewArgs {
 }
 
 pub fn run(args: &ViewArgs) -> Result<()> {
+    crate::common::check_threads(args.threads)?;
     let source = match &args.scene {
         Some(p) => SceneSource::File(p.clone()),
         None => SceneSource::BuiltIn,

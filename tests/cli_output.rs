@@ -1,0 +1,261 @@
+//! Where `glint render -o` writes, what it refuses, and the limits that
+//! protect the machine: run through the real binary.
+
+mod common;
+
+use std::os::unix::fs::FileTypeExt;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const PNG_SIGNATURE: &[u8] = b"\x89PNG\r\n\x1a\n";
+
+fn glint(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_glint"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn scene() -> String {
+    common::repo_path("scenes/sphere.toml")
+        .to_string_lossy()
+        .into_owned()
+}
+
+/// A fresh directory for one test.
+fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("glint-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn small(out: &Path) -> Vec<String> {
+    vec![
+        "render".into(),
+        scene(),
+        "--width".into(),
+        "16".into(),
+        "--height".into(),
+        "12".into(),
+        "-o".into(),
+        out.to_string_lossy().into_owned(),
+    ]
+}
+
+fn run(args: &[String]) -> Output {
+    let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+    glint(&refs)
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn a_symbolic_link_is_written_through_to_its_target() {
+    let d = dir("link");
+    let target = d.join("target.png");
+    std::fs::write(&target, b"old").unwrap();
+    let link = d.join("link.png");
+    std::os::unix::fs::symlink("target.png", &link).unwrap();
+    let o = run(&small(&link));
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink(),
+        "still a link"
+    );
+    assert!(
+        std::fs::read(&target).unwrap().starts_with(PNG_SIGNATURE),
+        "the target holds the PNG"
+    );
+    // A link to a file not yet there creates the file at the link's target.
+    let dangling = d.join("dangling.png");
+    std::os::unix::fs::symlink("new.png", &dangling).unwrap();
+    let o = run(&small(&dangling));
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        std::fs::read(d.join("new.png"))
+            .unwrap()
+            .starts_with(PNG_SIGNATURE)
+    );
+    // No temporary file is left behind.
+    let names: Vec<String> = std::fs::read_dir(&d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(names.iter().all(|n| !n.contains(".tmp")), "{names:?}");
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn a_fifo_is_written_not_replaced() {
+    let d = dir("fifo");
+    let fifo = d.join("pipe");
+    let status = Command::new("mkfifo").arg(&fifo).status().unwrap();
+    assert!(status.success());
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || std::fs::read(fifo).unwrap())
+    };
+    let o = run(&small(&fifo));
+    if !o.status.success() {
+        // Unblock the reader before failing.
+        let _ = std::fs::OpenOptions::new().write(true).open(&fifo);
+        panic!("{}", stderr(&o));
+    }
+    let bytes = reader.join().unwrap();
+    assert!(
+        bytes.starts_with(PNG_SIGNATURE),
+        "the reader got {} bytes",
+        bytes.len()
+    );
+    assert!(
+        std::fs::metadata(&fifo).unwrap().file_type().is_fifo(),
+        "still a FIFO"
+    );
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn dash_writes_the_png_to_standard_output() {
+    let d = dir("stdout");
+    let o = Command::new(env!("CARGO_BIN_EXE_glint"))
+        .current_dir(&d)
+        .args([
+            "render",
+            &scene(),
+            "--width",
+            "16",
+            "--height",
+            "12",
+            "-o",
+            "-",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(o.stdout.starts_with(PNG_SIGNATURE));
+    let image = image::load_from_memory(&o.stdout).unwrap();
+    assert_eq!((image.width(), image.height()), (16, 12));
+    assert!(!d.join("-").exists(), "no file named -");
+    // Standard output cannot carry the image and JSON at once.
+    let o = glint(&["render", &scene(), "-o", "-", "--stats"]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("standard output"), "{}", stderr(&o));
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn other_extensions_and_the_input_scene_are_refused() {
+    let d = dir("refuse");
+    for name in ["out.jpg", "out", "scene.toml"] {
+        let out = d.join(name);
+        let o = run(&small(&out));
+        assert!(!o.status.success(), "{name} accepted");
+        assert!(
+            stderr(&o).contains("name the output .png"),
+            "{name}: {}",
+            stderr(&o)
+        );
+        assert!(!out.exists(), "{name} was written");
+    }
+    // The scene being rendered, even under a .png name (a re-render).
+    let first = d.join("first.png");
+    assert!(run(&small(&first)).status.success());
+    let before = std::fs::read(&first).unwrap();
+    let o = glint(&[
+        "render",
+        "--from-png",
+        first.to_str().unwrap(),
+        "-o",
+        first.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("is the scene being rendered"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(std::fs::read(&first).unwrap(), before, "left untouched");
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn success_is_one_line_on_stderr_unless_quiet() {
+    let d = dir("quiet");
+    let out = d.join("a.png");
+    let o = run(&small(&out));
+    let text = stderr(&o);
+    assert_eq!(text.lines().count(), 1, "{text}");
+    assert!(
+        text.starts_with(&format!("wrote {} (16x12, ", out.display())),
+        "{text}"
+    );
+    let mut quiet = small(&out);
+    quiet.push("--quiet".into());
+    let o = run(&quiet);
+    assert!(o.status.success() && o.stderr.is_empty(), "{}", stderr(&o));
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn trace_pixel_with_an_output_writes_both() {
+    let d = dir("trace");
+    let out = d.join("a.png");
+    let mut args = small(&out);
+    args.extend(["--trace-pixel".into(), "8,6".into()]);
+    let o = run(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let tree: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(tree["pixel"], serde_json::json!([8, 6]));
+    assert!(std::fs::read(&out).unwrap().starts_with(PNG_SIGNATURE));
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn limits_are_stated_when_refused() {
+    let o = glint(&[
+        "render",
+        &scene(),
+        "--threads",
+        "100000",
+        "-o",
+        "/tmp/never.png",
+    ]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("per core"), "{}", stderr(&o));
+    let o = glint(&[
+        "render",
+        &scene(),
+        "--width",
+        "20000",
+        "--height",
+        "20000",
+        "-o",
+        "/tmp/never.png",
+    ]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("at most 268435456 pixels"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!Path::new("/tmp/never.png").exists());
+    // The memory estimate, against a machine with 1 GiB available.
+    let mut settings =
+        glint::render::RenderSettings::from_scene(&common::load("scenes/sphere.toml"));
+    (settings.width, settings.height) = (8192, 8192);
+    let e = glint::render::check_memory_against(&settings, 0, 1 << 30)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("8192x8192 render needs about 3456 MiB") && e.contains("819 MiB"),
+        "{e}"
+    );
+    (settings.width, settings.height) = (1024, 1024);
+    assert!(glint::render::check_memory_against(&settings, 0, 1 << 30).is_ok());
+}
