@@ -15,9 +15,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::accel::OctreeParams;
 use crate::camera::CameraSpec;
+use crate::frame::Frame;
 use crate::math::DVec3;
-use crate::render::{Frame, RenderSettings};
 use crate::scene::Scene;
+use crate::settings::RenderSettings;
 
 /// Text-chunk keywords. Part of the file format: never rename them.
 pub const KEY_VERSION: &str = "glint:version";
@@ -113,7 +114,7 @@ impl RenderRecord {
         Self {
             glint_version: env!("CARGO_PKG_VERSION").to_string(),
             scene_path: scene_path.to_string(),
-            scene_sha256: crate::sha256::sha256_hex(scene.source_text.as_bytes()),
+            scene_sha256: sha256_hex(scene.source_text.as_bytes()),
             scene_text: scene.source_text.to_string(),
             settings: RecordedSettings {
                 camera: camera.into(),
@@ -463,7 +464,7 @@ pub fn read_record(path: &Path) -> Result<RenderRecord, ExportError> {
         key: KEY_SETTINGS,
         message,
     })?;
-    let computed = crate::sha256::sha256_hex(record.scene_text.as_bytes());
+    let computed = sha256_hex(record.scene_text.as_bytes());
     if computed != record.scene_sha256 {
         return Err(ExportError::Checksum {
             path: path.to_owned(),
@@ -472,6 +473,12 @@ pub fn read_record(path: &Path) -> Result<RenderRecord, ExportError> {
         });
     }
     Ok(record)
+}
+
+/// SHA-256 of `bytes` as 64 lowercase hex digits (FIPS 180-4, `sha2`).
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    use sha2::Digest;
+    format!("{:x}", sha2::Sha256::digest(bytes))
 }
 
 fn compress(data: &[u8]) -> std::io::Result<Vec<u8>> {
@@ -563,8 +570,12 @@ fn private_chunk(path: &Path, kind: [u8; 4]) -> Result<Option<Vec<u8>>, ExportEr
 /// record (a PNG is user input like any other).
 fn validate(s: &RecordedSettings) -> Result<(), String> {
     let r = &s.render;
-    if !(1..=crate::scene::toml_format::MAX_DEPTH_LIMIT as u32).contains(&r.max_depth) {
-        return Err(format!("max_depth {} is outside 1..=64", r.max_depth));
+    if !(1..=crate::scene::MAX_RAY_DEPTH).contains(&r.max_depth) {
+        return Err(format!(
+            "max_depth {} is outside 1..={}",
+            r.max_depth,
+            crate::scene::MAX_RAY_DEPTH
+        ));
     }
     if s.octree_params.max_depth > crate::accel::MAX_OCTREE_DEPTH {
         return Err(format!(
@@ -585,7 +596,11 @@ fn validate(s: &RecordedSettings) -> Result<(), String> {
             crate::accel::MAX_MEMORY_BUDGET_MIB
         ));
     }
-    if r.width == 0 || r.height == 0 || r.width as u64 * r.height as u64 > 1 << 28 {
+    if r.width == 0
+        || r.height == 0
+        || r.width.max(r.height) > crate::scene::MAX_IMAGE_SIDE
+        || r.width as u64 * r.height as u64 > crate::scene::MAX_PIXELS
+    {
         return Err(format!(
             "image size {}x{} is not allowed",
             r.width, r.height

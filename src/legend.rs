@@ -3,29 +3,13 @@
 //! states its own scale. A 5x7 bitmap font keeps a font crate out of the
 //! headless build.
 
-/// Viridis (van der Walt & Smith, matplotlib 2015) sampled at nine evenly
-/// spaced points; linear interpolation between them is within a few levels
-/// of the full table and keeps it perceptually ordered.
-const VIRIDIS: [[u8; 3]; 9] = [
-    [68, 1, 84],
-    [71, 44, 122],
-    [59, 81, 139],
-    [44, 113, 142],
-    [33, 144, 141],
-    [39, 173, 129],
-    [92, 200, 99],
-    [170, 220, 50],
-    [253, 231, 37],
-];
-
-/// Viridis colour of `t` in `[0, 1]` (clamped; NaN maps to the low end).
+/// Viridis colour of `t` in `[0, 1]` (clamped; NaN maps to the low end):
+/// the perceptually ordered map of van der Walt & Smith (matplotlib 2015),
+/// from the `colorous` crate's table.
 pub fn viridis(t: f64) -> [u8; 3] {
     let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
-    let x = t * (VIRIDIS.len() - 1) as f64;
-    let i = (x.floor() as usize).min(VIRIDIS.len() - 2);
-    let f = x - i as f64;
-    let (a, b) = (VIRIDIS[i], VIRIDIS[i + 1]);
-    [0, 1, 2].map(|c| (a[c] as f64 + (b[c] as f64 - a[c] as f64) * f).round() as u8)
+    let c = colorous::VIRIDIS.eval_continuous(t);
+    [c.r, c.g, c.b]
 }
 
 /// What a legend strip says: a colour bar from `low` to `high` labelled at
@@ -304,10 +288,11 @@ mod tests {
 
     #[test]
     fn viridis_runs_dark_to_bright_and_clamps() {
-        assert_eq!(viridis(0.0), VIRIDIS[0]);
-        assert_eq!(viridis(1.0), VIRIDIS[8]);
-        assert_eq!(viridis(-3.0), VIRIDIS[0]);
-        assert_eq!(viridis(f64::NAN), VIRIDIS[0]);
+        // The map's published end points: dark purple to yellow.
+        assert_eq!(viridis(0.0), [68, 1, 84]);
+        assert_eq!(viridis(1.0), [253, 231, 37]);
+        assert_eq!(viridis(-3.0), viridis(0.0));
+        assert_eq!(viridis(f64::NAN), viridis(0.0));
         // Perceptual order: luminance grows along the map.
         let luma = |c: [u8; 3]| 0.2126 * c[0] as f64 + 0.7152 * c[1] as f64 + 0.0722 * c[2] as f64;
         let mut last = -1.0;
@@ -335,6 +320,6 @@ mod tests {
         assert!(rgb[..(w * h * 3) as usize].iter().all(|&b| b == 7));
         let strip = &rgb[(w * h * 3) as usize..];
         assert!(strip.chunks(3).any(|p| p == [235, 235, 235]));
-        assert!(strip.chunks(3).any(|p| p == VIRIDIS[8]));
+        assert!(strip.chunks(3).any(|p| p == viridis(1.0)));
     }
 }

@@ -4,10 +4,10 @@
 //! ```no_run
 //! let scene = glint::scene::load(std::path::Path::new("scenes/spheres.toml"))?;
 //! let octree = glint::accel::Octree::build(&scene.shapes, scene.octree_params)?;
-//! let settings = glint::render::RenderSettings::from_scene(&scene);
+//! let settings = glint::settings::RenderSettings::from_scene(&scene);
 //! let renderer = glint::render::Renderer::new(&scene, &octree, settings)?;
 //! let (frame, _counts) = renderer.render(false, None);
-//! frame.save_png(std::path::Path::new("spheres.png"))?;
+//! glint::export::save_png(&frame, std::path::Path::new("spheres.png"), None)?;
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
@@ -18,16 +18,19 @@ pub mod adaptive;
 pub mod camera;
 pub mod color;
 pub mod export;
+pub mod frame;
 pub mod legend;
 pub mod material;
 pub mod math;
+pub mod memory;
+pub mod metrics;
 pub mod overlay;
 pub mod ray_tree;
 pub mod render;
 pub mod scene;
 pub mod settings;
-pub mod sha256;
 pub mod shapes;
 pub mod stats;
+pub mod tiles;
 #[cfg(feature = "gui")]
 pub mod viewer;

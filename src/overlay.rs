@@ -82,15 +82,23 @@ fn clip(p: (f64, f64), q: (f64, f64), w: f64, h: f64) -> Option<((f64, f64), (f6
     ))
 }
 
+/// The cells in drawing order with their colours: fuller cells last, so
+/// they stay visible where edges overlap. The PNG overlay and the viewer's
+/// both draw this list.
+pub fn styled_cells(cells: &[OctreeCell]) -> Vec<(&OctreeCell, [u8; 3])> {
+    let most = cells.iter().map(|c| c.references).max().unwrap_or(1);
+    let mut order: Vec<&OctreeCell> = cells.iter().collect();
+    order.sort_by_key(|c| c.references);
+    order
+        .into_iter()
+        .map(|c| (c, cell_color(c.references, most)))
+        .collect()
+}
+
 /// Draws `cells` as wireframe boxes into an RGB8 image the camera's size.
 pub fn draw_cells(rgb: &mut [u8], camera: &Camera, cells: &[OctreeCell]) {
     let (w, h) = (camera.width(), camera.height());
-    let most = cells.iter().map(|c| c.references).max().unwrap_or(1);
-    // Fuller cells last, so they stay visible where edges overlap.
-    let mut order: Vec<&OctreeCell> = cells.iter().collect();
-    order.sort_by_key(|c| c.references);
-    for cell in order {
-        let color = cell_color(cell.references, most);
+    for (cell, color) in styled_cells(cells) {
         for (p, q) in cell_segments(camera, cell) {
             let Some((p, q)) = clip(p, q, w as f64 - 1e-9, h as f64 - 1e-9) else {
                 continue;
@@ -113,7 +121,7 @@ pub fn draw_cells(rgb: &mut [u8], camera: &Camera, cells: &[OctreeCell]) {
 /// `depth` drawn over it, and a legend strip (the view's own, or else the
 /// overlay's colour scale). Returns the bytes and the height.
 pub fn annotate(
-    frame: &crate::render::Frame,
+    frame: &crate::frame::Frame,
     camera: &Camera,
     cells: &[OctreeCell],
     depth: u32,

@@ -5,8 +5,10 @@
 mod common;
 
 use glint::accel::Octree;
-use glint::render::{AntiAliasing, Frame, RenderSettings, Renderer};
+use glint::frame::Frame;
+use glint::render::Renderer;
 use glint::scene::Scene;
+use glint::settings::{AntiAliasing, RenderSettings};
 
 fn render(scene: &Scene, octree: &Octree, aa: AntiAliasing, w: u32, h: u32) -> (Frame, u64) {
     let mut settings = RenderSettings::from_scene(scene);

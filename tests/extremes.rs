@@ -7,8 +7,9 @@ use common::{diff, load, render_with};
 use glint::accel::Octree;
 use glint::camera::{Camera, CameraSpec};
 use glint::math::{DVec3, Ray};
-use glint::render::{RenderSettings, Renderer};
+use glint::render::Renderer;
 use glint::scene::Scene;
+use glint::settings::RenderSettings;
 use glint::shapes::{PreparedRay, Quadric, Shape, Sphere, Triangle};
 use proptest::prelude::*;
 

@@ -7,10 +7,13 @@ use std::path::Path;
 use std::process::Command;
 
 use glint::accel::Octree;
+use glint::frame::Frame;
 use glint::math::DVec3;
+use glint::metrics::image_error;
 use glint::ray_tree::{RayKind, RayNode};
-use glint::render::{Frame, RenderSettings, Renderer, ViewMode, image_error};
+use glint::render::Renderer;
 use glint::scene::{FileSystem, Scene};
+use glint::settings::{RenderSettings, ViewMode};
 
 /// A mirror sphere and a glass sphere over a floor, two lights.
 const MIRROR_AND_GLASS: &str = r#"
@@ -174,7 +177,7 @@ fn ray_tree_of_a_glass_pixel_has_reflection_and_refraction_and_sums_to_the_pixel
         let p = ((j * s.width + i) * 3) as usize;
         let root = DVec3::from_array(tree.color);
         let enc = [root.x, root.y, root.z]
-            .map(|c| (glint::render::linear_to_srgb(c) * 255.0).round() as u8);
+            .map(|c| (glint::color::linear_to_srgb(c) * 255.0).round() as u8);
         assert_eq!(
             enc,
             [rgb[p], rgb[p + 1], rgb[p + 2]],
@@ -318,7 +321,7 @@ fn exports_record_how_they_were_made_and_render_again_identically() {
         assert_eq!(record.scene_text, text);
         assert_eq!(
             record.scene_sha256,
-            glint::sha256::sha256_hex(text.as_bytes())
+            glint::export::sha256_hex(text.as_bytes())
         );
 
         let (n, largest) = common::rerender_from_png(&first, &again);

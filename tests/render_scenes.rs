@@ -5,10 +5,12 @@ mod common;
 use common::{all_scenes, diff, load, render_with};
 use glint::accel::Octree;
 use glint::camera::CameraSpec;
+use glint::color::linear_to_srgb;
 use glint::material::{Light, Material};
 use glint::math::DVec3;
-use glint::render::{RenderSettings, Renderer, ViewMode, linear_to_srgb};
+use glint::render::Renderer;
 use glint::scene::{ImageSettings, Scene};
+use glint::settings::{RenderSettings, ViewMode};
 use glint::shapes::{Plane, Quadric, Shape, Sphere};
 
 #[test]

@@ -10,8 +10,9 @@ use common::{render_with, repo_path};
 use glint::accel::{Octree, OctreeParams};
 use glint::camera::Camera;
 use glint::math::DVec3;
-use glint::render::{RenderSettings, Renderer, ViewMode};
+use glint::render::Renderer;
 use glint::scene::Scene;
+use glint::settings::{RenderSettings, ViewMode};
 
 fn scene_from(text: &str, name: &str) -> Scene {
     glint::scene::load_str(text, Path::new(name), &glint::scene::FileSystem)

@@ -11,8 +11,9 @@ use glint::accel::Octree;
 use glint::color::ColorConvention;
 use glint::math::DVec3;
 use glint::ray_tree::{RayKind, RayNode};
-use glint::render::{Protocol, RenderSettings, Renderer, ViewMode};
+use glint::render::Renderer;
 use glint::scene::Scene;
+use glint::settings::{Protocol, RenderSettings, ViewMode};
 
 fn scene_from(text: &str, name: &str) -> Scene {
     glint::scene::load_str(text, Path::new(name), &glint::scene::FileSystem)
@@ -86,12 +87,12 @@ fn corner_rays_make_each_pixel_the_mean_of_its_four_corners() {
     }
     // Tiles share their edge corners; the counts still see each corner
     // once, and the tiled frame (the viewer's) equals the whole one.
-    let tiles = glint::render::tiles(w, h);
+    let tiles = glint::tiles::tiles(w, h);
     let results: Vec<_> = tiles
         .iter()
         .map(|&t| renderer.render_tile(t, false))
         .collect();
-    let (tiled, tiled_counts) = glint::render::assemble_tiles(&settings, &tiles, results);
+    let (tiled, tiled_counts) = glint::tiles::assemble_tiles(&settings, &tiles, results);
     assert_eq!(tiled, frame);
     assert_eq!(tiled_counts.rays, counts.rays);
 }
@@ -106,7 +107,7 @@ fn a_512_square_image_casts_513_squared_eye_rays_in_any_tiling() {
     let renderer = Renderer::new(&scene, &octree, settings).unwrap();
     let (_, counts) = renderer.render(false, None);
     assert_eq!(counts.rays.primary, 513 * 513);
-    let tiles = glint::render::tiles(512, 512);
+    let tiles = glint::tiles::tiles(512, 512);
     let tiled: u64 = tiles
         .iter()
         .map(|&t| renderer.render_tile(t, false).1.rays.primary)

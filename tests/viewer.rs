@@ -10,7 +10,8 @@ use std::time::Duration;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use glint::accel::Octree;
-use glint::render::{RenderSettings, Renderer};
+use glint::render::Renderer;
+use glint::settings::RenderSettings;
 use glint::viewer::worker::{Job, PassKind, Worker};
 use glint::viewer::{GlintApp, SceneSource, ViewerOptions};
 
@@ -196,7 +197,7 @@ fn a_new_job_cancels_the_old_one_within_a_tile() {
         total_first <= started_at_cancel + threads as u64,
         "after cancellation at most one more tile per thread: {started_at_cancel} then {total_first}"
     );
-    let tiles_in_full_job = 2 * glint::render::tiles(640, 480).len() as u64;
+    let tiles_in_full_job = 2 * glint::tiles::tiles(640, 480).len() as u64;
     assert!(
         total_first < tiles_in_full_job,
         "the first job did not run to completion"
@@ -336,7 +337,7 @@ fn clicking_in_inspect_mode_picks_the_pixel_and_its_ray_tree() {
 
 #[test]
 fn viewer_exports_render_again_identically_from_their_metadata() {
-    use glint::render::ViewMode;
+    use glint::settings::ViewMode;
     let dir = std::env::temp_dir().join(format!("glint-viewer-export-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let (first, again) = (dir.join("first.png"), dir.join("again.png"));
@@ -408,9 +409,9 @@ fn protocol_spd_in_the_viewer_is_one_corner_pass_equal_to_the_cli() {
     h.get_by_label("spd").click();
     h.run_steps(2);
     let settings = *h.state().settings();
-    assert_eq!(settings.protocol, glint::render::Protocol::Spd);
+    assert_eq!(settings.protocol, glint::settings::Protocol::Spd);
     assert_eq!(settings.max_depth, 5, "the protocol's depth");
-    assert_eq!(settings.sides, glint::render::Sides::One);
+    assert_eq!(settings.sides, glint::settings::Sides::One);
     assert!(h.state().worker().generation() > before, "restarted");
     settle(&mut h);
     let generation = h.state().worker().generation();
@@ -461,7 +462,7 @@ fn adaptive_refinement_pass_equals_the_cli_adaptive_render() {
     let refined = last.refined_pixels.expect("an adaptive pass");
     assert!(refined > 0 && refined < 120 * 90);
     let mut cli_settings = settings;
-    cli_settings.set_anti_aliasing(glint::render::AntiAliasing::Adaptive);
+    cli_settings.set_anti_aliasing(glint::settings::AntiAliasing::Adaptive);
     let (frame, counts) = Renderer::new(&scene, &octree, cli_settings)
         .unwrap()
         .render(false, None);

@@ -55,6 +55,13 @@ impl std::str::FromStr for Sides {
     }
 }
 
+/// Largest image side, pixel count and recursion depth glint accepts,
+/// from a file, the command line or a record: beyond these a typo would
+/// ask for gigabytes or recurse without end.
+pub const MAX_IMAGE_SIDE: u32 = 1 << 15;
+pub const MAX_PIXELS: u64 = 1 << 28;
+pub const MAX_RAY_DEPTH: u32 = 64;
+
 /// Image and recursion settings stored with a scene; command-line flags and
 /// the viewer override them.
 #[derive(Clone, Debug, PartialEq)]

@@ -237,7 +237,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 tokens.label("hither")?;
                 let _hither = tokens.number("hither")?;
                 tokens.label("resolution")?;
-                let limit = super::toml_format::MAX_IMAGE_SIDE as usize;
+                let limit = super::MAX_IMAGE_SIDE as usize;
                 let w = tokens.count("resolution", limit)?;
                 let h = tokens.count("resolution", limit)?;
                 if w == 0 || h == 0 {

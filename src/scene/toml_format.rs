@@ -8,7 +8,7 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::mesh::{MeshSource, Placement, parse_obj};
-use super::{ImageSettings, Location, Scene, SceneError};
+use super::{ImageSettings, Location, MAX_IMAGE_SIDE, MAX_RAY_DEPTH, Scene, SceneError};
 use crate::accel::OctreeParams;
 use crate::camera::CameraSpec;
 use crate::material::{
@@ -196,11 +196,6 @@ impl Context<'_> {
     }
 }
 
-/// Largest image side and recursion depth a file may ask for: beyond these
-/// a typo would allocate gigabytes or recurse without end.
-pub const MAX_IMAGE_SIDE: i64 = 1 << 15;
-pub const MAX_DEPTH_LIMIT: i64 = 64;
-
 pub fn parse(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, SceneError> {
     let cx = Context { text, path };
     // Syntax errors have a place but no key; type errors get their key path
@@ -253,10 +248,10 @@ pub fn parse(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, S
     let mut image = ImageSettings::default();
     let im = &file.image;
     if let Some(v) = &im.width {
-        image.width = cx.integer(v, "image.width", 1..MAX_IMAGE_SIDE + 1)?;
+        image.width = cx.integer(v, "image.width", 1..MAX_IMAGE_SIDE as i64 + 1)?;
     }
     if let Some(v) = &im.height {
-        image.height = cx.integer(v, "image.height", 1..MAX_IMAGE_SIDE + 1)?;
+        image.height = cx.integer(v, "image.height", 1..MAX_IMAGE_SIDE as i64 + 1)?;
     }
     if let Some(v) = &im.samples {
         image.samples = cx.integer(v, "image.samples", 1..17)?;
@@ -265,7 +260,7 @@ pub fn parse(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, S
         }
     }
     if let Some(v) = &im.max_depth {
-        image.max_depth = cx.integer(v, "image.max_depth", 1..MAX_DEPTH_LIMIT + 1)?;
+        image.max_depth = cx.integer(v, "image.max_depth", 1..MAX_RAY_DEPTH as i64 + 1)?;
     }
     if let Some(v) = &im.background {
         image.background = cx.color(v, "image.background", &INTENSITY_RANGE)?;
@@ -452,23 +447,22 @@ fn add_object(
             ));
         }
     }
-    let required = |name: &str, has: bool| -> Result<(), SceneError> {
-        if has {
-            Ok(())
-        } else {
-            Err(cx.error(
-                obj.kind.span(),
-                &key(name),
-                format!("a {kind} needs `{name}`"),
-            ))
-        }
+    let missing = |name: &str| {
+        cx.error(
+            obj.kind.span(),
+            &key(name),
+            format!("a {kind} needs `{name}`"),
+        )
     };
 
     match kind {
         "sphere" => {
-            required("center", obj.center.is_some())?;
-            required("radius", obj.radius.is_some())?;
-            let (c, r) = (obj.center.as_ref().unwrap(), obj.radius.as_ref().unwrap());
+            let Some(c) = &obj.center else {
+                return Err(missing("center"));
+            };
+            let Some(r) = &obj.radius else {
+                return Err(missing("radius"));
+            };
             let center = cx.vec3(c, &key("center"))?;
             let radius = cx.finite(r, &key("radius"))?;
             if radius <= 0.0 {
@@ -481,10 +475,13 @@ fn add_object(
             scene.push(Shape::Sphere(Sphere::new(center, radius)), material);
         }
         "plane" => {
-            required("point", obj.point.is_some())?;
-            required("normal", obj.normal.is_some())?;
-            let point = cx.vec3(obj.point.as_ref().unwrap(), &key("point"))?;
-            let n = obj.normal.as_ref().unwrap();
+            let Some(point) = &obj.point else {
+                return Err(missing("point"));
+            };
+            let Some(n) = &obj.normal else {
+                return Err(missing("normal"));
+            };
+            let point = cx.vec3(point, &key("point"))?;
             let normal = cx.vec3(n, &key("normal"))?;
             if !(normal.length() > 0.0) {
                 return Err(cx.error(n.span(), &key("normal"), "must not be the zero vector"));
@@ -492,8 +489,9 @@ fn add_object(
             scene.push(Shape::Plane(Plane::new(point, normal)), material);
         }
         "triangle" => {
-            required("vertices", obj.vertices.is_some())?;
-            let v = obj.vertices.as_ref().unwrap();
+            let Some(v) = &obj.vertices else {
+                return Err(missing("vertices"));
+            };
             let vertices = v.get_ref().map(DVec3::from);
             if !vertices.iter().all(|p| p.is_finite()) {
                 return Err(cx.error(v.span(), &key("vertices"), "must be finite numbers"));
@@ -504,8 +502,9 @@ fn add_object(
             }
         }
         "quadric" => {
-            required("coefficients", obj.coefficients.is_some())?;
-            let c = obj.coefficients.as_ref().unwrap();
+            let Some(c) = &obj.coefficients else {
+                return Err(missing("coefficients"));
+            };
             let coefficients = *c.get_ref();
             if !coefficients.iter().all(|x| x.is_finite()) {
                 return Err(cx.error(c.span(), &key("coefficients"), "must be ten finite numbers"));
@@ -539,8 +538,9 @@ fn add_object(
             );
         }
         "mesh" => {
-            required("path", obj.path.is_some())?;
-            let p = obj.path.as_ref().unwrap();
+            let Some(p) = &obj.path else {
+                return Err(missing("path"));
+            };
             let mesh_path = cx.path.parent().unwrap_or(Path::new("")).join(p.get_ref());
             let scale = match &obj.scale {
                 Some(s) => {

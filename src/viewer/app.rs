@@ -13,8 +13,8 @@ use super::worker::{Job, PassKind, PassRecord, Preview, Worker};
 use crate::accel::Octree;
 use crate::camera::CameraSpec;
 use crate::export::{RenderRecord, SceneEdits};
-use crate::render::{RenderSettings, ViewMode};
 use crate::scene::Scene;
+use crate::settings::{RenderSettings, ViewMode};
 
 /// Where the current scene came from.
 #[derive(Clone, Debug, PartialEq)]
@@ -26,7 +26,7 @@ pub enum SceneSource {
 impl SceneSource {
     pub fn load(&self) -> anyhow::Result<Scene> {
         Ok(match self {
-            SceneSource::BuiltIn => super::builtin::default_scene()?,
+            SceneSource::BuiltIn => crate::scene::builtin::default_scene()?,
             SceneSource::File(p) => crate::scene::load(p)?,
         })
     }
@@ -55,7 +55,7 @@ pub struct ViewerOptions {
     /// Initial settings that differ from the scene's (view mode, octree, AA).
     pub view: Option<ViewMode>,
     pub octree: Option<bool>,
-    pub anti_aliasing: Option<crate::render::AntiAliasing>,
+    pub anti_aliasing: Option<crate::settings::AntiAliasing>,
     /// Image size overriding the scene's.
     pub size: Option<(u32, u32)>,
     /// Start with the octree overlay drawn down to this level.
@@ -69,9 +69,9 @@ pub struct ViewerOptions {
     pub compare_difference: bool,
     /// Start with these rules instead of the scene's (the protocol first:
     /// it sets its depth and sidedness).
-    pub protocol: Option<crate::render::Protocol>,
+    pub protocol: Option<crate::settings::Protocol>,
     pub colors: Option<crate::color::ColorConvention>,
-    pub sides: Option<crate::render::Sides>,
+    pub sides: Option<crate::settings::Sides>,
 }
 
 /// A setting `--compare` flips for the A image.
@@ -155,8 +155,8 @@ impl GlintApp {
         let worker = Worker::spawn(options.threads, repaint);
         let mut settings = RenderSettings::from_scene(&scene);
         let aa = options.anti_aliasing.unwrap_or(settings.anti_aliasing());
-        let anti_aliasing = aa != crate::render::AntiAliasing::Off;
-        settings.adaptive = aa == crate::render::AntiAliasing::Adaptive;
+        let anti_aliasing = aa != crate::settings::AntiAliasing::Off;
+        settings.adaptive = aa == crate::settings::AntiAliasing::Adaptive;
         if let Some(v) = options.view {
             settings.view = v;
         }
@@ -560,7 +560,7 @@ impl GlintApp {
             anyhow::bail!("nothing has been rendered yet");
         };
         let name = match &self.source {
-            SceneSource::BuiltIn => super::builtin::NAME.to_string(),
+            SceneSource::BuiltIn => crate::scene::builtin::NAME.to_string(),
             SceneSource::File(p) => p.display().to_string(),
         };
         let mut record = RenderRecord::new(&source.scene, &name, &source.camera, source.settings);
@@ -692,6 +692,9 @@ impl GlintApp {
     /// One frame of the viewer: drawn into `ui`, which covers the window.
     pub fn frame_ui(&mut self, ui: &mut egui::Ui) {
         let ctx = ui.ctx().clone();
+        if let Some(failure) = self.worker.take_failure() {
+            self.say(failure, true);
+        }
         if !self.asked_focus {
             // Keys (R, Ctrl+S) work only in a focused window, and some
             // window managers focus a new window only when clicked.
@@ -912,9 +915,9 @@ mod tests {
             finished_at: 1.0,
             one_sample_error: None,
             refined_pixels: None,
-            view: crate::render::ViewMode::Shaded,
+            view: crate::settings::ViewMode::Shaded,
             max_depth: 5,
-            protocol: crate::render::Protocol::Glint,
+            protocol: crate::settings::Protocol::Glint,
         }
     }
 
@@ -934,10 +937,10 @@ mod tests {
             samples: 1,
             max_depth: 5,
             use_octree: true,
-            view: crate::render::ViewMode::Shaded,
-            protocol: crate::render::Protocol::Glint,
+            view: crate::settings::ViewMode::Shaded,
+            protocol: crate::settings::Protocol::Glint,
             colors: crate::color::ColorConvention::Linear,
-            sides: crate::render::Sides::Two,
+            sides: crate::settings::Sides::Two,
             adaptive: false,
             shadows: true,
         };

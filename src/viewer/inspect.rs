@@ -12,7 +12,8 @@ use crate::accel::OctreeCell;
 use crate::camera::Camera;
 use crate::math::DVec3;
 use crate::ray_tree::{RayKind, RayNode};
-use crate::render::{RenderSettings, Renderer, ViewMode};
+use crate::render::Renderer;
+use crate::settings::{RenderSettings, ViewMode};
 
 /// The inspected pixel and the tree of rays its centre ray spawned.
 #[derive(Clone, Debug)]
@@ -363,11 +364,8 @@ impl GlintApp {
         let painter = ui.painter_at(image_rect);
         if let Some(depth) = self.inspect.overlay_depth {
             let cells = self.overlay_cells(depth);
-            let most = cells.iter().map(|c| c.references).max().unwrap_or(1);
-            let mut order: Vec<&OctreeCell> = cells.iter().collect();
-            order.sort_by_key(|c| c.references);
-            for cell in order {
-                let color = color32(crate::overlay::cell_color(cell.references, most));
+            for (cell, color) in crate::overlay::styled_cells(&cells) {
+                let color = color32(color);
                 for (a, b) in crate::overlay::cell_segments(&camera, cell) {
                     painter.line_segment(
                         [

@@ -9,7 +9,3 @@ mod panels;
 pub mod worker;
 
 pub use app::{GlintApp, SceneSource, ViewerOptions};
-
-/// The built-in default scene lives in the library so the command line can
-/// re-render exports made from it.
-pub use crate::scene::builtin;

@@ -8,7 +8,7 @@ use super::app::{Command, GlintApp};
 use super::worker::PassKind;
 use crate::color::ColorConvention;
 use crate::math::DVec3;
-use crate::render::{Protocol, RenderSettings, Sides, ViewMode};
+use crate::settings::{Protocol, RenderSettings, Sides, ViewMode};
 
 pub fn menu_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
     egui::MenuBar::new().ui(ui, |ui| {

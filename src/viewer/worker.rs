@@ -16,10 +16,13 @@ use rayon::prelude::*;
 
 use crate::accel::Octree;
 use crate::camera::CameraSpec;
+use crate::frame::Frame;
 use crate::math::DVec3;
-use crate::render::{Frame, RenderSettings, Renderer, TileCounts, ViewMode, tiles};
+use crate::render::Renderer;
 use crate::scene::Scene;
+use crate::settings::{RenderSettings, ViewMode};
 use crate::stats::RayCounts;
+use crate::tiles::{TileCounts, tiles};
 
 /// What to render. `settings.samples` is ignored: the worker runs the
 /// 1-sample pass, then the 16-sample pass if `anti_aliasing`.
@@ -100,15 +103,15 @@ pub struct PassRecord {
     pub finished_at: f64,
     /// For a 16-sample pass: the error of the same generation's 1-sample
     /// pass against it (what anti-aliasing changed).
-    pub one_sample_error: Option<crate::render::ImageError>,
+    pub one_sample_error: Option<crate::metrics::ImageError>,
     /// For an adaptive 16-sample pass: the pixels it refined (the rest kept
     /// their 1-sample value).
     pub refined_pixels: Option<u64>,
     /// What the pass showed, and the settings that decide its time apart
     /// from anti-aliasing (passes are compared only when these agree).
-    pub view: crate::render::ViewMode,
+    pub view: crate::settings::ViewMode,
     pub max_depth: u32,
-    pub protocol: crate::render::Protocol,
+    pub protocol: crate::settings::Protocol,
 }
 
 /// The display buffer: RGBA8, exactly what the viewer shows and exports.
@@ -167,6 +170,8 @@ struct Shared {
     /// When the UI was last asked to repaint for new tiles.
     last_repaint: Mutex<Instant>,
     one_sample: OneSampleFrame,
+    /// What went wrong in the worker, for the status bar (taken by the UI).
+    failure: Mutex<Option<String>>,
 }
 
 /// Tiles arrive far faster than a screen refreshes; asking for a repaint
@@ -177,6 +182,12 @@ struct Shared {
 const REPAINT_INTERVAL: Duration = Duration::from_millis(100);
 
 impl Shared {
+    /// Records a failure for the status bar and wakes the UI to show it.
+    fn fail(&self, message: String) {
+        *self.failure.lock().unwrap_or_else(|e| e.into_inner()) = Some(message);
+        (self.repaint)();
+    }
+
     fn repaint_soon(&self) {
         let mut last = self.last_repaint.lock().unwrap_or_else(|e| e.into_inner());
         if last.elapsed() >= REPAINT_INTERVAL {
@@ -207,13 +218,20 @@ impl Worker {
             tiles_started: Mutex::new(Vec::new()),
             last_repaint: Mutex::new(Instant::now()),
             one_sample: Mutex::new(None),
+            failure: Mutex::new(None),
         });
         let (tx, rx) = channel();
         let thread_shared = Arc::clone(&shared);
-        let thread = std::thread::Builder::new()
+        let thread = match std::thread::Builder::new()
             .name("glint-render".into())
             .spawn(move || run(thread_shared, rx, threads))
-            .ok();
+        {
+            Ok(t) => Some(t),
+            Err(e) => {
+                shared.fail(format!("cannot start the render thread: {e}"));
+                None
+            }
+        };
         Self {
             shared,
             jobs: Some(tx),
@@ -233,6 +251,15 @@ impl Worker {
 
     pub fn generation(&self) -> u64 {
         self.shared.generation.load(Ordering::SeqCst)
+    }
+
+    /// What went wrong in the worker since the last call, if anything.
+    pub fn take_failure(&self) -> Option<String> {
+        self.shared
+            .failure
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .take()
     }
 
     /// Calls `f` with the buffer if the lock is free; the UI never waits.
@@ -298,7 +325,10 @@ fn run(shared: Arc<Shared>, rx: Receiver<(u64, Job)>, threads: usize) {
         .build()
     {
         Ok(p) => p,
-        Err(_) => return,
+        Err(e) => {
+            shared.fail(format!("cannot start the render threads: {e}"));
+            return;
+        }
     };
     while let Ok(mut next) = rx.recv() {
         // Only the newest job matters.
@@ -363,8 +393,12 @@ fn render_pass(
     if shown_view == ViewMode::AaNeed {
         settings.view = ViewMode::Shaded;
     }
-    let Ok(renderer) = Renderer::with_camera(&job.scene, &job.octree, settings, &job.camera) else {
-        return false;
+    let renderer = match Renderer::with_camera(&job.scene, &job.octree, settings, &job.camera) {
+        Ok(r) => r,
+        Err(e) => {
+            shared.fail(format!("cannot render: {e}"));
+            return false;
+        }
     };
     let (w, h) = (settings.width, settings.height);
     let all = tiles(w, h);
@@ -406,7 +440,7 @@ fn render_pass(
     }
     // Adaptive anti-aliasing: the 1-sample pass keeps what each pixel's ray
     // met, the 16-sample pass refines where that or the picture has an edge.
-    let adaptive = settings.anti_aliasing() == crate::render::AntiAliasing::Adaptive
+    let adaptive = settings.anti_aliasing() == crate::settings::AntiAliasing::Adaptive
         || (kind == PassKind::OneSample && job.settings.adaptive && job.anti_aliasing);
     let first_pass = if kind == PassKind::SixteenSamples && adaptive {
         let one = shared.one_sample.lock().unwrap_or_else(|e| e.into_inner());
@@ -440,7 +474,7 @@ fn render_pass(
                 None if kind == PassKind::OneSample && adaptive => {
                     let (values, sig, counts) = renderer.first_pass_tile(tile, false);
                     let mut all_sig = signatures.lock().unwrap_or_else(|e| e.into_inner());
-                    crate::render::place_tile(&mut all_sig, w, &tile, &sig);
+                    crate::tiles::place_tile(&mut all_sig, w, &tile, &sig);
                     (values, counts)
                 }
                 None => renderer.render_tile(tile, false),
@@ -469,7 +503,7 @@ fn render_pass(
     let seconds = start.elapsed().as_secs_f64();
     // Assemble the exact frame, as `glint render` would, and publish it.
     let (frame, counts) =
-        crate::render::assemble_tiles(&settings, &all, results.into_iter().flatten());
+        crate::tiles::assemble_tiles(&settings, &all, results.into_iter().flatten());
     let one_sample_error = {
         let mut one = shared.one_sample.lock().unwrap_or_else(|e| e.into_inner());
         match kind {
@@ -483,7 +517,7 @@ fn render_pass(
                 .as_ref()
                 .filter(|(g, f, _)| *g == generation && f.pixels.len() == frame.pixels.len())
                 .map(|(_, f, _)| {
-                    crate::render::image_error(&f.pixels, &frame.pixels, frame.colors)
+                    crate::metrics::image_error(&f.pixels, &frame.pixels, frame.colors)
                 }),
             PassKind::Preview(_) | PassKind::Corners => None,
         }
@@ -567,7 +601,7 @@ fn tile_rgba(
             let range = {
                 let mut r = depth_range.lock().unwrap_or_else(|e| e.into_inner());
                 for v in values {
-                    let c = crate::render::cost_value(*v, view);
+                    let c = crate::frame::cost_value(*v, view);
                     r.0 = r.0.min(c);
                     r.1 = r.1.max(c);
                 }
@@ -576,8 +610,8 @@ fn tile_rgba(
             values
                 .iter()
                 .flat_map(|v| {
-                    crate::legend::viridis(crate::render::cost_shade(
-                        crate::render::cost_value(*v, view),
+                    crate::legend::viridis(crate::frame::cost_shade(
+                        crate::frame::cost_value(*v, view),
                         range,
                     ))
                 })
@@ -587,13 +621,13 @@ fn tile_rgba(
             let near = {
                 let mut r = depth_range.lock().unwrap_or_else(|e| e.into_inner());
                 if values.iter().any(|v| v.y > 0.0) {
-                    r.0 = r.0.min(crate::render::nearest_depth(values));
+                    r.0 = r.0.min(crate::frame::nearest_depth(values));
                 }
                 r.0
             };
             values
                 .iter()
-                .flat_map(|v| [(crate::render::depth_shade(*v, near) * 255.0).round() as u8; 3])
+                .flat_map(|v| [(crate::frame::depth_shade(*v, near) * 255.0).round() as u8; 3])
                 .collect()
         }
         _ => Frame {

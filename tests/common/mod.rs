@@ -4,8 +4,10 @@
 use std::path::{Path, PathBuf};
 
 use glint::accel::Octree;
-use glint::render::{RenderSettings, Renderer, TileCounts};
+use glint::render::Renderer;
 use glint::scene::Scene;
+use glint::settings::RenderSettings;
+use glint::tiles::TileCounts;
 
 pub fn repo_path(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)

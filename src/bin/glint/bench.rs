@@ -5,11 +5,14 @@ use std::time::Instant;
 
 use anyhow::{Result, bail};
 use glint::accel::{Octree, OctreeStats};
-use glint::render::{RenderSettings, Renderer, TileCounts};
+use glint::render::Renderer;
+use glint::settings::RenderSettings;
+use glint::tiles::TileCounts;
 use serde::Serialize;
 
 use crate::common::{
-    OctreeArgs, RulesArgs, load_scene, parse_positive, parse_samples, parse_size, thread_pool,
+    OctreeArgs, RulesArgs, load_scene, median, parse_positive, parse_samples, parse_size,
+    thread_pool,
 };
 
 #[derive(clap::Args)]
@@ -26,7 +29,7 @@ pub struct BenchArgs {
     pub samples: Option<u32>,
     /// Anti-aliasing: off, adaptive or full (see `glint render --aa`).
     #[arg(long, value_parser = crate::common::parse_aa, conflicts_with = "samples")]
-    pub aa: Option<glint::render::AntiAliasing>,
+    pub aa: Option<glint::settings::AntiAliasing>,
     /// Longest ray path (default: each scene's own; the SPD protocol fixes 5).
     #[arg(long, value_parser = parse_positive)]
     pub max_depth: Option<u32>,
@@ -54,8 +57,8 @@ pub struct BenchArgs {
     pub octree_only: bool,
     /// What the image shows (default: shaded); `normals` and `depth`
     /// trace eye rays only.
-    #[arg(long, value_parser = |s: &str| s.parse::<glint::render::ViewMode>())]
-    pub view: Option<glint::render::ViewMode>,
+    #[arg(long, value_parser = |s: &str| s.parse::<glint::settings::ViewMode>())]
+    pub view: Option<glint::settings::ViewMode>,
     /// Instead of octree on/off, sweep the octree parameters: every
     /// combination of these maximum depths, leaf sizes and cost-driven
     /// on/off, octree on, one row each (medians of `--repeat` runs).
@@ -122,7 +125,7 @@ struct SceneBench {
     rays_total: u64,
     /// Rays by kind (eye rays, those that hit, shadow, reflection, refraction).
     rays: glint::stats::RayCounts,
-    protocol: glint::render::Protocol,
+    protocol: glint::settings::Protocol,
     /// The SPD's published counts for this scene (default SPD scenes at
     /// 512x512 under `--protocol spd` only).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -158,16 +161,6 @@ fn published_counts(scene: &str) -> Option<PublishedCounts> {
         refraction,
         shadow,
     })
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
 }
 
 fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
@@ -295,7 +288,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             rays_total,
             rays: counted_on.rays,
             protocol: settings.protocol,
-            published: (settings.protocol == glint::render::Protocol::Spd
+            published: (settings.protocol == glint::settings::Protocol::Spd
                 && (settings.width, settings.height) == (512, 512))
                 .then(|| published_counts(&path.display().to_string()))
                 .flatten(),
@@ -354,7 +347,7 @@ fn markdown(results: &[SceneBench]) -> String {
             r.shapes,
             r.width,
             r.height,
-            if r.protocol == glint::render::Protocol::Spd {
+            if r.protocol == glint::settings::Protocol::Spd {
                 "corners".to_string()
             } else {
                 r.samples.to_string()

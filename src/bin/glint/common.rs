@@ -19,6 +19,18 @@ impl Switch {
     }
 }
 
+/// The median of timings: the middle one, or the mean of the middle two
+/// (`NaN` for none).
+pub fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    match n {
+        0 => f64::NAN,
+        _ if n % 2 == 1 => v[n / 2],
+        _ => 0.5 * (v[n / 2 - 1] + v[n / 2]),
+    }
+}
+
 /// Loads a scene and reports how long it took.
 pub fn load_scene(path: &Path) -> Result<(Scene, f64)> {
     let start = Instant::now();
@@ -61,9 +73,9 @@ pub fn parse_samples(s: &str) -> std::result::Result<u32, String> {
 }
 
 /// `off`, `adaptive` or `full` (and the viewer's older `on` for full).
-pub fn parse_aa(s: &str) -> std::result::Result<glint::render::AntiAliasing, String> {
+pub fn parse_aa(s: &str) -> std::result::Result<glint::settings::AntiAliasing, String> {
     match s {
-        "on" => Ok(glint::render::AntiAliasing::Full),
+        "on" => Ok(glint::settings::AntiAliasing::Full),
         _ => s.parse(),
     }
 }
@@ -103,8 +115,8 @@ pub struct RulesArgs {
     /// or spd (the SPD test protocol: rays through the 513x513 pixel
     /// corners of a 512x512 image, depth 5, a reflection ray from every
     /// reflective or transmitting surface, opaque surfaces one-sided).
-    #[arg(long, value_parser = |s: &str| s.parse::<glint::render::Protocol>())]
-    pub protocol: Option<glint::render::Protocol>,
+    #[arg(long, value_parser = |s: &str| s.parse::<glint::settings::Protocol>())]
+    pub protocol: Option<glint::settings::Protocol>,
     /// Colour convention: linear (shade in linear light, write sRGB; the
     /// default for TOML scenes) or display (shade display values, write
     /// them unchanged; the default for NFF scenes).
@@ -113,14 +125,14 @@ pub struct RulesArgs {
     /// Sidedness: two (every surface seen from both sides; glint's default)
     /// or one (opaque surfaces seen from outside only; the SPD protocol's
     /// default, which keeps patches with vertex normals two-sided).
-    #[arg(long, value_parser = |s: &str| s.parse::<glint::render::Sides>())]
-    pub sides: Option<glint::render::Sides>,
+    #[arg(long, value_parser = |s: &str| s.parse::<glint::settings::Sides>())]
+    pub sides: Option<glint::settings::Sides>,
 }
 
 impl RulesArgs {
     /// Refuses settings the SPD protocol fixes itself.
     pub fn check(&self, max_depth: Option<u32>, samples: Option<u32>) -> Result<()> {
-        if self.protocol == Some(glint::render::Protocol::Spd) {
+        if self.protocol == Some(glint::settings::Protocol::Spd) {
             anyhow::ensure!(
                 max_depth.is_none(),
                 "--protocol spd fixes the ray depth at 5: drop --max-depth"
@@ -135,7 +147,7 @@ impl RulesArgs {
 
     /// Applies the flags: the protocol first (it sets its depth and
     /// sidedness), then explicit colour and sidedness choices.
-    pub fn apply(&self, settings: &mut glint::render::RenderSettings) {
+    pub fn apply(&self, settings: &mut glint::settings::RenderSettings) {
         if let Some(p) = self.protocol {
             *settings = settings.with_protocol(p);
         }

@@ -6,7 +6,8 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use glint::accel::{Octree, OctreeStats};
-use glint::render::{RenderSettings, Renderer, ViewMode};
+use glint::render::Renderer;
+use glint::settings::{RenderSettings, ViewMode};
 use glint::stats::RayCounts;
 use serde::Serialize;
 
@@ -43,7 +44,7 @@ pub struct RenderArgs {
     /// neighbours differ: another material, a shadow edge, a visible
     /// contrast). `--samples 1|16` means off|full.
     #[arg(long, value_parser = crate::common::parse_aa, conflicts_with = "samples")]
-    pub aa: Option<glint::render::AntiAliasing>,
+    pub aa: Option<glint::settings::AntiAliasing>,
     /// Longest ray path; the eye ray is depth 1 (the SPD protocol fixes 5).
     #[arg(long, value_parser = parse_positive)]
     pub max_depth: Option<u32>,
@@ -103,7 +104,7 @@ struct TraceJson<'a> {
     max_depth: u32,
     octree: bool,
     /// Under `spd` the tree is the pixel's top-left corner ray's.
-    protocol: glint::render::Protocol,
+    protocol: glint::settings::Protocol,
     colors: glint::color::ColorConvention,
     /// The pixel's value at 1 sample (shading values) and as written to
     /// PNG (encoded by the colour convention; the name is historical).
@@ -132,10 +133,10 @@ struct RenderStats {
     octree: bool,
     octree_params: glint::accel::OctreeParams,
     view: ViewMode,
-    protocol: glint::render::Protocol,
+    protocol: glint::settings::Protocol,
     colors: glint::color::ColorConvention,
-    sides: glint::render::Sides,
-    aa: glint::render::AntiAliasing,
+    sides: glint::settings::Sides,
+    aa: glint::settings::AntiAliasing,
     /// Pixels the adaptive anti-aliasing refined with the full grid, and
     /// their share of the image (0 unless `aa` is adaptive).
     refined_pixels: u64,
@@ -269,7 +270,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     // Validate before starting (the aa-need view renders twice).
     Renderer::with_camera(&scene, &octree, settings, &camera)
         .with_context(|| format!("cannot render {scene_name}"))?;
-    glint::render::check_memory(&settings, octree.stats().memory_bytes)
+    glint::memory::check_memory(&settings, octree.stats().memory_bytes)
         .with_context(|| format!("cannot render {scene_name}"))?;
     let bar = std::io::stderr().is_terminal().then(|| {
         let bar = indicatif::ProgressBar::new(1);

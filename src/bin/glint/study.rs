@@ -11,11 +11,14 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use glint::accel::{Octree, OctreeParams};
+use glint::frame::Frame;
 use glint::math::DVec3;
-use glint::render::{Frame, RenderSettings, Renderer, image_error};
+use glint::metrics::image_error;
+use glint::render::Renderer;
 use glint::scene::Scene;
+use glint::settings::RenderSettings;
 
-use crate::common::{load_scene, parse_positive, thread_pool};
+use crate::common::{load_scene, median, parse_positive, parse_size, thread_pool};
 
 #[derive(clap::Args)]
 pub struct StudyArgs {
@@ -26,19 +29,14 @@ pub struct StudyArgs {
     #[arg(long, default_value = "study")]
     pub out: PathBuf,
     /// Image size as WIDTHxHEIGHT (default: 320x240).
-    #[arg(long, default_value = "320x240")]
-    pub size: String,
+    #[arg(long, default_value = "320x240", value_parser = parse_size)]
+    pub size: (u32, u32),
     /// Timed runs per configuration (the median is reported).
     #[arg(long, default_value_t = 3, value_parser = parse_positive)]
     pub repeat: u32,
     /// Render threads (default: one per core; at most 8 per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 struct Study<'a> {
@@ -96,12 +94,7 @@ fn upsample(f: &Frame, width: u32, height: u32) -> Vec<DVec3> {
 
 /// Writes `|a - b|` (sRGB-encoded difference, scaled by `gain`) as a PNG.
 pub fn run(args: &StudyArgs) -> Result<()> {
-    let (w, h) = args
-        .size
-        .split_once('x')
-        .and_then(|(a, b)| Some((a.parse::<u32>().ok()?, b.parse::<u32>().ok()?)))
-        .filter(|&(a, b)| a > 0 && b > 0)
-        .with_context(|| format!("--size expects WIDTHxHEIGHT, got `{}`", args.size))?;
+    let (w, h) = args.size;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let mut md = String::new();
@@ -116,7 +109,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
             .collect::<Vec<_>>()
             .join(" "),
         args.out.display(),
-        args.size,
+        format_args!("{w}x{h}"),
         args.repeat,
         args.repeat,
         thread_pool(args.threads)?.current_num_threads()
@@ -178,7 +171,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
                 if let Some(one) = &one {
                     let need = args.out.join(format!("{stem}-aa-need.png"));
                     // The same picture as `glint render --view aa-need`, legend included.
-                    Frame::aa_need(one, &f).save_png(&need)?;
+                    glint::export::save_png(&Frame::aa_need(one, &f), &need, None)?;
                     let e = image_error(&one.pixels, &f.pixels, base.colors);
                     summary.push((
                         stem.clone(),

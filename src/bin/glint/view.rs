@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::{Result, anyhow};
-use glint::render::ViewMode;
+use glint::settings::ViewMode;
 use glint::viewer::app::CompareSetting;
 use glint::viewer::{GlintApp, SceneSource, ViewerOptions};
 
@@ -29,7 +29,7 @@ pub struct ViewArgs {
     /// Start with anti-aliasing off, adaptive or full (`on` is full;
     /// default: the scene's).
     #[arg(long, value_parser = crate::common::parse_aa)]
-    pub aa: Option<glint::render::AntiAliasing>,
+    pub aa: Option<glint::settings::AntiAliasing>,
     /// Image size as WIDTHxHEIGHT (default: the scene's).
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
@@ -37,8 +37,8 @@ pub struct ViewArgs {
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
     /// Window size as WIDTHxHEIGHT in points.
-    #[arg(long, default_value = "1400x860")]
-    pub window: String,
+    #[arg(long, default_value = "1400x860", value_parser = parse_size)]
+    pub window: (u32, u32),
     /// Start with the octree overlay drawn down to this level.
     #[arg(long, value_name = "DEPTH")]
     pub overlay_depth: Option<u32>,
@@ -74,7 +74,7 @@ impl Default for ViewArgs {
             aa: None,
             threads: 0,
             size: None,
-            window: "1400x860".into(),
+            window: (1400, 860),
             overlay_depth: None,
             inspect: None,
             compare: None,
@@ -92,11 +92,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     };
     // Load once up front so a bad scene is a clear error, not a blank window.
     source.load()?;
-    let (w, h) = args
-        .window
-        .split_once('x')
-        .and_then(|(w, h)| Some((w.parse::<f32>().ok()?, h.parse::<f32>().ok()?)))
-        .ok_or_else(|| anyhow!("--window expects WIDTHxHEIGHT, got `{}`", args.window))?;
+    let (w, h) = (args.window.0 as f32, args.window.1 as f32);
     let options = ViewerOptions {
         screenshot: args.screenshot.clone(),
         frames: args.frames,

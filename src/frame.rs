@@ -1,0 +1,248 @@
+//! A rendered image and how it becomes pixels: the frame's per-view
+//! content, its 8-bit encoding, the legend of the diagnostic views, and the
+//! aa-need difference. Writing files is [`crate::export`]'s (which uses
+//! frames; frames never use it).
+
+use rayon::prelude::*;
+
+use crate::color::{ColorConvention, to_byte};
+use crate::math::{Color, DVec3};
+use crate::settings::ViewMode;
+
+/// Gain of the aa-need view: a difference of 1/4 shows at full brightness.
+pub const AA_NEED_GAIN: f64 = 4.0;
+
+/// A rendered image: linear RGB for [`ViewMode::Shaded`] and
+/// [`ViewMode::Normals`]; for [`ViewMode::Depth`] the mean distance in `x`
+/// and the fraction of samples that hit in `y`; for the cost views the
+/// pixel's intersection tests, traversal steps and leaves visited in `x`,
+/// `y`, `z` (summed over its samples and every ray they spawned); for
+/// [`ViewMode::AaNeed`] the absolute sRGB difference per channel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    pub width: u32,
+    pub height: u32,
+    pub view: ViewMode,
+    /// How shaded values are written (see [`ColorConvention`]).
+    pub colors: ColorConvention,
+    pub pixels: Vec<DVec3>,
+}
+
+/// One pixel of a frame, as its view means it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Pixel {
+    /// Shaded colour (shading values: linear light or display values).
+    Color(Color),
+    /// The geometric normal facing the camera, as `(n + 1) / 2`.
+    Normal(DVec3),
+    /// Mean distance of the samples that hit, and the share that hit.
+    Depth { distance: f64, coverage: f64 },
+    /// Intersection tests, traversal steps and leaves entered of every ray
+    /// the pixel spawned.
+    Work { tests: f64, steps: f64, leaves: f64 },
+    /// |1 sample - 16 samples| per channel, as displayed.
+    Difference(DVec3),
+}
+
+impl Frame {
+    /// Pixel `index` (row-major from the top) as its view means it: the one
+    /// place that reads the raw per-pixel triple.
+    pub fn pixel(&self, index: usize) -> Pixel {
+        let p = self.pixels[index];
+        match self.view {
+            ViewMode::Shaded => Pixel::Color(p),
+            ViewMode::Normals => Pixel::Normal(p),
+            ViewMode::Depth => Pixel::Depth {
+                distance: p.x,
+                coverage: p.y,
+            },
+            ViewMode::Cost | ViewMode::CostSteps => Pixel::Work {
+                tests: p.x,
+                steps: p.y,
+                leaves: p.z,
+            },
+            ViewMode::AaNeed => Pixel::Difference(p),
+        }
+    }
+}
+
+/// The nearest visible distance among depth-view pixels (0 if none hit).
+pub fn nearest_depth(pixels: &[DVec3]) -> f64 {
+    pixels
+        .iter()
+        .filter(|p| p.y > 0.0)
+        .map(|p| p.x)
+        .fold(f64::INFINITY, f64::min)
+        .min(f64::MAX)
+        .max(0.0)
+}
+
+/// Grey level of a depth-view pixel: `near / distance`, so the nearest
+/// visible point is white and the shade falls off with distance towards
+/// black at the horizon. (A linear ramp to the farthest point fails on
+/// infinite planes, whose far end is at the horizon and would wash out
+/// everything else.) Misses are black; partly covered pixels fade.
+pub fn depth_shade(p: DVec3, near: f64) -> f64 {
+    if p.y <= 0.0 || !(p.x > 0.0) {
+        0.0
+    } else {
+        (near / p.x).clamp(0.0, 1.0) * p.y
+    }
+}
+
+/// Smallest, largest and mean per-pixel cost of a cost view.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CostSummary {
+    pub min: f64,
+    pub max: f64,
+    pub mean: f64,
+}
+
+/// The count a cost-view pixel shows.
+pub fn cost_value(p: DVec3, view: ViewMode) -> f64 {
+    if view == ViewMode::CostSteps {
+        p.y
+    } else {
+        p.x
+    }
+}
+
+/// Position of `value` on the colour map for a frame whose costs span `range`.
+pub fn cost_shade(value: f64, (min, max): (f64, f64)) -> f64 {
+    if max > min {
+        (value - min) / (max - min)
+    } else {
+        0.0
+    }
+}
+
+fn format_count(v: f64) -> String {
+    if v.fract() == 0.0 && v.abs() < 1e9 {
+        format!("{v:.0}")
+    } else {
+        format!("{v:.1}")
+    }
+}
+
+impl Frame {
+    /// 8-bit RGB, row-major from the top: the shaded view encoded by its
+    /// colour convention (sRGB for linear light), normals raw, depth
+    /// normalised to the visible range.
+    pub fn to_rgb8(&self) -> Vec<u8> {
+        // Frame-wide values first, then every pixel on its own, in parallel
+        // (the sRGB encoding of an 800x600 frame is 1.4 million powers).
+        let near = (self.view == ViewMode::Depth).then(|| nearest_depth(&self.pixels));
+        let range = self.cost_summary().map_or((0.0, 0.0), |c| (c.min, c.max));
+        let encode = |p: &DVec3| -> [u8; 3] {
+            match self.view {
+                ViewMode::Shaded => [p.x, p.y, p.z].map(|c| to_byte(self.colors.encode(c))),
+                ViewMode::Normals => [p.x, p.y, p.z].map(to_byte),
+                ViewMode::Depth => [to_byte(depth_shade(*p, near.unwrap_or(0.0))); 3],
+                ViewMode::Cost | ViewMode::CostSteps => {
+                    crate::legend::viridis(cost_shade(cost_value(*p, self.view), range))
+                }
+                ViewMode::AaNeed => [p.x, p.y, p.z].map(|c| to_byte(c * AA_NEED_GAIN)),
+            }
+        };
+        let mut out = vec![0u8; self.pixels.len() * 3];
+        out.par_chunks_mut(3 * 4096)
+            .zip(self.pixels.par_chunks(4096))
+            .for_each(|(bytes, pixels)| {
+                for (b, p) in bytes.chunks_exact_mut(3).zip(pixels) {
+                    b.copy_from_slice(&encode(p));
+                }
+            });
+        out
+    }
+
+    /// The per-pixel cost of a cost view: its smallest, largest and mean.
+    pub fn cost_summary(&self) -> Option<CostSummary> {
+        if !self.view.is_cost() || self.pixels.is_empty() {
+            return None;
+        }
+        let values = self.pixels.iter().map(|p| cost_value(*p, self.view));
+        let (mut min, mut max, mut sum) = (f64::INFINITY, 0.0f64, 0.0);
+        for v in values {
+            min = min.min(v);
+            max = max.max(v);
+            sum += v;
+        }
+        Some(CostSummary {
+            min,
+            max,
+            mean: sum / self.pixels.len() as f64,
+        })
+    }
+
+    /// The 1-sample picture's difference from the 16-sample one, as the
+    /// [`ViewMode::AaNeed`] view: `|display(one) − display(sixteen)|` per
+    /// channel (sRGB-encoded values for linear frames).
+    pub fn aa_need(one: &Frame, sixteen: &Frame) -> Frame {
+        let enc = |v: DVec3| sixteen.colors.encode_rgb(v);
+        Frame {
+            width: sixteen.width,
+            height: sixteen.height,
+            view: ViewMode::AaNeed,
+            colors: sixteen.colors,
+            pixels: one
+                .pixels
+                .iter()
+                .zip(&sixteen.pixels)
+                .map(|(p, q)| (enc(*p) - enc(*q)).abs())
+                .collect(),
+        }
+    }
+
+    /// What the legend strip of a diagnostic view says (none for the
+    /// pictures that explain themselves).
+    pub fn legend(&self) -> Option<crate::legend::Legend> {
+        use crate::legend::{Legend, Ramp};
+        match self.view {
+            ViewMode::Cost | ViewMode::CostSteps => {
+                let c = self.cost_summary()?;
+                let what = if self.view == ViewMode::Cost {
+                    "intersection tests"
+                } else {
+                    "traversal steps"
+                };
+                Some(Legend {
+                    low: format_count(c.min),
+                    high: format_count(c.max),
+                    caption: format!("{what} per pixel, mean {}", format_count(c.mean)),
+                    ramp: Ramp::Viridis,
+                })
+            }
+            ViewMode::AaNeed => {
+                let visible = self
+                    .pixels
+                    .iter()
+                    .filter(|p| p.max_element() > 1.0 / 255.0)
+                    .count() as f64
+                    / self.pixels.len().max(1) as f64;
+                Some(Legend {
+                    low: "0".into(),
+                    high: format!("{:.2}", 1.0 / AA_NEED_GAIN),
+                    caption: format!(
+                        "|1-16 spp| x{AA_NEED_GAIN}: {:.1}% px > 1/255",
+                        100.0 * visible
+                    ),
+                    ramp: Ramp::Grey,
+                })
+            }
+            _ => None,
+        }
+    }
+
+    /// The RGB8 picture as written to PNG: [`Frame::to_rgb8`] with the
+    /// legend strip appended for the diagnostic views. Returns the height.
+    pub fn to_annotated_rgb8(&self) -> (Vec<u8>, u32) {
+        let mut rgb = self.to_rgb8();
+        let height = match self.legend() {
+            Some(legend) => {
+                crate::legend::append_legend(&mut rgb, self.width, self.height, &legend)
+            }
+            None => self.height,
+        };
+        (rgb, height)
+    }
+}

@@ -1,0 +1,51 @@
+//! How far one image is from another: the error figures `glint study` and
+//! the viewer report.
+
+use crate::color::ColorConvention;
+use crate::math::DVec3;
+
+/// Root-mean-square error and PSNR of an image against a reference, in
+/// shading values (linear light, or display values under
+/// [`ColorConvention::Display`]) and as displayed (after the convention's
+/// encoding: sRGB for linear frames), both on [0, 1] with channels clamped.
+#[derive(Clone, Copy, Debug)]
+pub struct ImageError {
+    pub rmse_shaded: f64,
+    pub psnr_shaded: f64,
+    pub rmse_display: f64,
+    pub psnr_display: f64,
+    /// Fraction of pixels differing by more than 1/255 as displayed.
+    pub visible_fraction: f64,
+}
+
+pub fn image_error(a: &[DVec3], reference: &[DVec3], colors: ColorConvention) -> ImageError {
+    let (mut shaded, mut display, mut visible) = (0.0, 0.0, 0usize);
+    for (p, q) in a.iter().zip(reference) {
+        let (p, q) = (
+            p.clamp(DVec3::ZERO, DVec3::ONE),
+            q.clamp(DVec3::ZERO, DVec3::ONE),
+        );
+        shaded += (p - q).length_squared();
+        let d = colors.encode_rgb(p) - colors.encode_rgb(q);
+        display += d.length_squared();
+        if d.abs().max_element() > 1.0 / 255.0 {
+            visible += 1;
+        }
+    }
+    let n = (a.len() * 3).max(1) as f64;
+    let (rs, rd) = ((shaded / n).sqrt(), (display / n).sqrt());
+    let psnr = |r: f64| {
+        if r > 0.0 {
+            -20.0 * r.log10()
+        } else {
+            f64::INFINITY
+        }
+    };
+    ImageError {
+        rmse_shaded: rs,
+        psnr_shaded: psnr(rs),
+        rmse_display: rd,
+        psnr_display: psnr(rd),
+        visible_fraction: visible as f64 / a.len().max(1) as f64,
+    }
+}
