@@ -653,3 +653,146 @@ pub fn load_recorded_scene(record: &RenderRecord) -> Result<Scene, ExportError> 
     }
     Ok(scene)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sha256_matches_the_fips_180_examples() {
+        assert_eq!(
+            sha256_hex(b"abc"),
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
+        );
+        assert_eq!(
+            sha256_hex(b""),
+            "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855"
+        );
+    }
+
+    fn record() -> RenderRecord {
+        let scene = crate::scene::builtin::default_scene().unwrap();
+        let mut settings = RenderSettings::from_scene(&scene);
+        settings.width = 4;
+        settings.height = 2;
+        RenderRecord::new(&scene, crate::scene::builtin::NAME, &scene.camera, settings)
+    }
+
+    /// A 4x2 image with a different colour in every pixel.
+    fn pixels() -> Vec<u8> {
+        (0..24u8).map(|k| k * 10).collect()
+    }
+
+    #[test]
+    fn a_record_and_the_pixels_read_back_as_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("round.png");
+        let written = record();
+        save_rgb_png(&path, 4, 2, &pixels(), Some(&written)).unwrap();
+        assert_eq!(read_record(&path).unwrap(), written);
+        let image = image::open(&path).unwrap().to_rgb8();
+        assert_eq!(image.dimensions(), (4, 2));
+        assert_eq!(image.into_raw(), pixels());
+        // The scene it names loads again from the embedded text.
+        let scene = load_recorded_scene(&written).unwrap();
+        assert_eq!(scene.source_text.as_ref(), written.scene_text);
+    }
+
+    #[test]
+    fn a_tampered_or_damaged_record_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("tampered.png");
+        let mut wrong = record();
+        wrong.scene_sha256 = sha256_hex(b"another scene");
+        save_rgb_png(&path, 4, 2, &pixels(), Some(&wrong)).unwrap();
+        assert!(matches!(
+            read_record(&path),
+            Err(ExportError::Checksum { .. })
+        ));
+
+        // One flipped bit inside the scene chunk: its CRC no longer matches.
+        save_rgb_png(&path, 4, 2, &pixels(), Some(&record())).unwrap();
+        let mut bytes = std::fs::read(&path).unwrap();
+        let at = bytes.windows(4).position(|w| w == SCENE_CHUNK).unwrap();
+        bytes[at + 10] ^= 1;
+        std::fs::write(&path, &bytes).unwrap();
+        assert!(matches!(
+            read_record(&path),
+            Err(ExportError::Decode { .. })
+        ));
+
+        // Settings outside the limits scene files are held to.
+        let mut deep = record();
+        deep.settings.render.max_depth = 0;
+        save_rgb_png(&path, 4, 2, &pixels(), Some(&deep)).unwrap();
+        assert!(matches!(
+            read_record(&path),
+            Err(ExportError::Malformed {
+                key: KEY_SETTINGS,
+                ..
+            })
+        ));
+
+        // A PNG without a record.
+        save_rgb_png(&path, 4, 2, &pixels(), None).unwrap();
+        assert!(matches!(
+            read_record(&path),
+            Err(ExportError::Missing { .. })
+        ));
+    }
+
+    #[test]
+    fn scene_text_compresses_losslessly_and_garbage_is_refused() {
+        let text = "[camera]\neye = [0, 1, 2]\n# ünïcödé\n".repeat(100);
+        let packed = compress(text.as_bytes()).unwrap();
+        assert!(packed.len() < text.len() / 10);
+        assert_eq!(decompress(&packed).unwrap(), text);
+        assert!(decompress(b"not zlib").is_err());
+        let not_utf8 = compress(&[0xff, 0xfe, 0x00]).unwrap();
+        assert!(decompress(&not_utf8).unwrap_err().contains("UTF-8"));
+    }
+
+    #[test]
+    fn outputs_must_be_png_files_other_than_the_input() {
+        let dir = tempfile::tempdir().unwrap();
+        let scene = dir.path().join("scene.toml");
+        std::fs::write(&scene, "").unwrap();
+        let out = dir.path().join("out.png");
+        assert_eq!(
+            check_output(&out, Some(&scene)).unwrap(),
+            OutputTarget::File(out.clone())
+        );
+        assert!(matches!(
+            check_output(&dir.path().join("out.jpg"), None),
+            Err(ExportError::NotPng { .. })
+        ));
+        // The scene itself, even named .png or reached through a link.
+        let png_scene = dir.path().join("scene.png");
+        std::fs::write(&png_scene, "").unwrap();
+        let link = dir.path().join("link.png");
+        std::os::unix::fs::symlink(&png_scene, &link).unwrap();
+        assert!(matches!(
+            check_output(&link, Some(&png_scene)),
+            Err(ExportError::IsInput { .. })
+        ));
+        assert_eq!(
+            check_output(Path::new("-"), None).unwrap(),
+            OutputTarget::Stdout
+        );
+        assert!(matches!(
+            check_output(Path::new("/dev/null"), None).unwrap(),
+            OutputTarget::Special(_)
+        ));
+    }
+
+    #[test]
+    fn a_link_to_a_file_not_yet_there_writes_the_file_it_names() {
+        let dir = tempfile::tempdir().unwrap();
+        let link = dir.path().join("latest.png");
+        std::os::unix::fs::symlink("renders/frame.png", &link).unwrap();
+        assert_eq!(
+            OutputTarget::resolve(&link).unwrap(),
+            OutputTarget::File(dir.path().join("renders/frame.png"))
+        );
+    }
+}

@@ -205,8 +205,36 @@ mod tests {
         };
         let mut rgb = vec![0u8; 64 * 48 * 3];
         draw_cells(&mut rgb, &cam, &[cell]);
-        let inked = rgb.chunks(3).filter(|p| p != &[0, 0, 0]).count();
-        assert!(inked > 100, "outline drawn ({inked} pixels)");
+        // Seen head-on from 4 and 6 units, the front face (z = 1) is a
+        // square of half-side 1/4 on the image plane at distance 1, the
+        // back face one of 1/6; pixels are 2 tan 30° / 48 wide, the centre
+        // at (32, 24). Lines ink the pixel each point falls in.
+        let pixel = 2.0 * 30f64.to_radians().tan() / 48.0;
+        let square = |half: f64| {
+            let r = half / pixel;
+            let lo = |c: f64| (c - r).floor() as u32;
+            let hi = |c: f64| (c + r).floor() as u32;
+            (lo(32.0), hi(32.0), lo(24.0), hi(24.0))
+        };
+        let inked = |x: u32, y: u32| rgb[((y * 64 + x) * 3) as usize..][..3] != [0, 0, 0];
+        for (left, right, top, bottom) in [square(0.25), square(1.0 / 6.0)] {
+            for y in top + 1..bottom {
+                assert!(inked(left, y) && inked(right, y), "sides at row {y}");
+            }
+            for x in left + 1..right {
+                assert!(inked(x, top) && inked(x, bottom), "top and bottom at {x}");
+            }
+        }
+        // Nothing outside the front square; inside, only the edges: the
+        // centre and a point between the two squares' sides stay black.
+        let (left, right, top, bottom) = square(0.25);
+        for y in 0..48 {
+            for x in 0..64 {
+                let within = (left..=right).contains(&x) && (top..=bottom).contains(&y);
+                assert!(within || !inked(x, y), "ink outside the outline at {x},{y}");
+            }
+        }
+        assert!(!inked(32, 24) && !inked(left + 2, 24));
         // The centre of the image looks through the box; the corner does not.
         assert_eq!(cell_at(&cam, &[cell], 32.0, 24.0), Some(&cell));
         assert_eq!(cell_at(&cam, &[cell], 0.5, 0.5), None);

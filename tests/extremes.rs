@@ -229,11 +229,27 @@ fn quadric_extremes() {
         .intersect(&Ray::new(on, -DVec3::X), f64::INFINITY)
         .expect("far side");
     assert!((inward.t - 2.0).abs() < 1e-12);
-    // A tangent ray grazes at exactly one point and yields a finite normal.
-    let tangent = Ray::new(DVec3::new(-5.0, 1.0, 0.0), DVec3::X);
-    if let Some(h) = unit.intersect(&tangent, f64::INFINITY) {
-        assert!(unit.surface(&tangent, &h).geometric_normal.is_finite());
+    // Rays grazing the unit sphere at height y: a chord of half-length
+    // sqrt(1 - y^2) centred at x = 0, entered at t = 5 - sqrt(1 - y^2)
+    // with the normal (-sqrt(1 - y^2), y, 0). Just inside, exactly at and
+    // just outside the silhouette.
+    for y in [1.0 - 1e-6, 1.0 - 1e-12, 1.0] {
+        let ray = Ray::new(DVec3::new(-5.0, y, 0.0), DVec3::X);
+        let half_chord = (1.0 - y * y).sqrt();
+        let hit = unit
+            .intersect(&ray, f64::INFINITY)
+            .unwrap_or_else(|| panic!("y = {y}: the grazing ray hits"));
+        assert!(
+            (hit.t - (5.0 - half_chord)).abs() < 1e-9,
+            "y = {y}: t = {}",
+            hit.t
+        );
+        let normal = unit.surface(&ray, &hit).geometric_normal.normalize();
+        let expected = DVec3::new(-half_chord, y, 0.0);
+        assert!((normal - expected).length() < 1e-6, "y = {y}: {normal}");
     }
+    let outside = Ray::new(DVec3::new(-5.0, 1.0 + 1e-12, 0.0), DVec3::X);
+    assert!(unit.intersect(&outside, f64::INFINITY).is_none());
 }
 
 #[test]
@@ -246,22 +262,76 @@ fn total_internal_reflection_at_great_depth_stays_finite() {
     assert!(counts.rays.refraction > 0 && counts.rays.reflection > 0);
 }
 
+/// A lone unit sphere at the origin seen from `distance` along +z.
+fn lone_sphere(distance: f64, fov: f64) -> Scene {
+    let mut scene = Scene::empty(
+        "lone sphere".into(),
+        CameraSpec {
+            eye: DVec3::new(0.0, 0.0, distance),
+            lookat: DVec3::ZERO,
+            up: DVec3::Y,
+            fov,
+        },
+        glint::scene::ImageSettings::default(),
+    );
+    scene.materials = vec![glint::material::Material::default()];
+    scene.lights = vec![glint::material::Light {
+        position: DVec3::new(1.0, 2.0, distance),
+        color: DVec3::ONE,
+    }];
+    scene.push(Shape::Sphere(Sphere::new(DVec3::ZERO, 1.0)), 0);
+    scene
+}
+
+/// Which pixel centres of a `w` x `h` image see [`lone_sphere`], from the
+/// pinhole's definition (fov the vertical angle edge to edge, square
+/// pixels) rather than glint's camera: (surely inside, within 1e-9 of the
+/// silhouette either way).
+fn sphere_pixels(w: u32, h: u32, fov: f64, distance: f64) -> (u64, u64) {
+    let radius = (1.0 / distance).asin().tan();
+    let pixel = 2.0 * (fov.to_radians() / 2.0).tan() / h as f64;
+    let (mut inside, mut border) = (0, 0);
+    for j in 0..h {
+        for i in 0..w {
+            let x = (i as f64 + 0.5 - w as f64 / 2.0) * pixel;
+            let y = (h as f64 / 2.0 - j as f64 - 0.5) * pixel;
+            let r = x.hypot(y);
+            if r < radius * (1.0 - 1e-9) {
+                inside += 1;
+            } else if r <= radius * (1.0 + 1e-9) {
+                border += 1;
+            }
+        }
+    }
+    (inside, border)
+}
+
 #[test]
-fn extreme_cameras_give_images_or_clear_errors() {
+fn extreme_cameras_and_image_shapes_see_what_the_pinhole_predicts() {
+    let distance = 2.5;
+    // fov 0.01: all pixels on the sphere; 179: only the centre one; 1x1:
+    // the centre; a column 10000 tall at fov 60: the rows within the
+    // sphere's angular radius, tan(asin(0.4)) / tan(30°) = 75.6% of them;
+    // a row 10000 wide: pixels 0.73 wide, the two beside the centre.
+    for (fov, w, h, expected) in [
+        (0.01, 8, 8, 64),
+        (179.0, 33, 25, 1),
+        (40.0, 1, 1, 1),
+        (60.0, 1, 10_000, 7_560),
+        (40.0, 10_000, 1, 2),
+    ] {
+        let scene = lone_sphere(distance, fov);
+        let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+        let (inside, border) = sphere_pixels(w, h, fov, distance);
+        assert_eq!((inside, border), (expected, 0), "the prediction itself");
+        let (_, one) = render_with(&scene, &octree, w, h, |r| r.samples = 1);
+        assert_eq!(one.rays.primary_hits, expected, "fov {fov}, {w}x{h}");
+        let (_, sixteen) = render_with(&scene, &octree, w, h, |r| r.samples = 16);
+        assert_eq!(sixteen.nonfinite_samples, 0, "fov {fov}, {w}x{h}");
+        assert_eq!(sixteen.rays.primary, 16 * w as u64 * h as u64);
+    }
     let scene = load("scenes/sphere.toml");
     let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
-    for fov in [0.01, 179.0] {
-        let mut s = scene.clone();
-        s.camera.fov = fov;
-        let (img, counts) = render_with(&s, &octree, 32, 24, |r| r.samples = 1);
-        assert_eq!(counts.nonfinite_samples, 0, "fov {fov}");
-        assert_eq!(img.len(), 32 * 24 * 3);
-    }
-    // fov 0.01 looks at the sphere's centre: every pixel is the sphere.
-    let mut narrow = scene.clone();
-    narrow.camera.fov = 0.01;
-    let (_, c) = render_with(&narrow, &octree, 8, 8, |r| r.samples = 1);
-    assert_eq!(c.rays.primary_hits, 64);
     // Up almost parallel to the view direction still forms a valid basis...
     let mut tilted = scene.clone();
     let view = (scene.camera.lookat - scene.camera.eye).normalize();
@@ -273,12 +343,6 @@ fn extreme_cameras_give_images_or_clear_errors() {
         .err()
         .expect("an error");
     assert!(err.to_string().contains("parallel"), "{err}");
-    // 1x1 and 1x10000 images.
-    for (w, h) in [(1, 1), (1, 10_000), (10_000, 1)] {
-        let (img, counts) = render_with(&scene, &octree, w, h, |r| r.samples = 16);
-        assert_eq!(img.len(), (w * h * 3) as usize);
-        assert_eq!(counts.nonfinite_samples, 0);
-    }
     let zero = Camera::new(
         &CameraSpec {
             fov: 40.0,

@@ -220,8 +220,38 @@ fn normals_and_depth_views_are_as_documented() {
         s.samples = 1;
         s.view = ViewMode::Depth;
     });
-    // Nearest is white; the sphere's front is nearer than the floor behind it.
-    assert_eq!(depth.iter().copied().max(), Some(255));
-    let far_floor = ((h / 2 - 8) * w * 3 + 3) as usize;
-    assert!(depth[mid] > depth[far_floor] || depth[far_floor] == 0);
+    // The grey level is near / distance (the nearest visible point white).
+    // Distances from the pinhole's definition: pixel centres on the image
+    // plane at distance 1, pixels 2 tan(fov/2) / h wide, in the basis
+    // w = back from the view, u = up x w, v = w x u.
+    let camera = scene.camera;
+    let back = (camera.eye - camera.lookat).normalize();
+    let right = camera.up.cross(back).normalize();
+    let up = back.cross(right);
+    let pixel = 2.0 * (camera.fov.to_radians() / 2.0).tan() / h as f64;
+    let ray = |i: u32, j: u32| {
+        let x = (i as f64 + 0.5 - w as f64 / 2.0) * pixel;
+        let y = (h as f64 / 2.0 - j as f64 - 0.5) * pixel;
+        (x * right + y * up - back).normalize()
+    };
+    // The floor (y = 0) from eye height; the middle ray runs through the
+    // sphere's centre, meeting it one radius before.
+    let floor = |i, j| camera.eye.y / -ray(i, j).y;
+    let sphere = (camera.eye - DVec3::new(0.0, 1.0, 0.0)).length() - 1.0;
+    // The nearest point is the floor at the bottom of the middle column.
+    let near = floor(w / 2, h - 1);
+    assert!(near < sphere);
+    let grey = |i: u32, j: u32| depth[((j * w + i) * 3) as usize] as f64;
+    let level = |distance: f64| 255.0 * near / distance;
+    assert_eq!(grey(w / 2, h - 1), 255.0);
+    assert!((grey(w / 2, h / 2) - level(sphere)).abs() <= 1.0, "sphere");
+    // Floor pixels left of the sphere, near and far.
+    for (i, j) in [(5, 50), (3, 40), (10, 33)] {
+        let expected = level(floor(i, j));
+        assert!(
+            (grey(i, j) - expected).abs() <= 1.0,
+            "pixel {i},{j}: {} vs {expected:.1}",
+            grey(i, j)
+        );
+    }
 }

@@ -457,14 +457,24 @@ pp 3
     }
 
     #[test]
-    fn angle_is_converted_to_edge_to_edge_fov() {
-        // The centres of rows 0 and h-1 span (h-1) pixels, the image h.
-        let fov = fov_from_nff_angle(45.0, 512);
-        let expected = 2.0
-            * ((22.5f64).to_radians().tan() * 512.0 / 511.0)
-                .atan()
-                .to_degrees();
-        assert!((fov - expected).abs() < 1e-12 && fov > 45.0);
+    fn the_angle_spans_the_centres_of_the_first_and_last_rows() {
+        // NFF.TXT: the angle is "from the center of top pixel row to bottom
+        // pixel row". Measured on the camera glint builds: the rays through
+        // those centres (in the middle of the image across) are 45° apart.
+        for (w, h) in [(512, 512), (64, 48), (2, 3)] {
+            let text = format!(
+                "v\nfrom 1 2 3\nat 0 0 0\nup 0 0 1\nangle 45\nhither 1\nresolution {w} {h}\nf 1 1 1 1 0 1 0 1\ns 0 0 0 1\n"
+            );
+            let scene = parse_str(&text).unwrap();
+            let camera = crate::camera::Camera::new(&scene.camera, w, h).unwrap();
+            // Pixel i's left edge plus dx: the image's vertical centre line.
+            let (i, dx) = (w / 2, if w % 2 == 0 { 0.0 } else { 0.5 });
+            let top = camera.ray(i, 0, dx, 0.5).dir;
+            let bottom = camera.ray(i, h - 1, dx, 0.5).dir;
+            let angle = top.dot(bottom).clamp(-1.0, 1.0).acos().to_degrees();
+            assert!((angle - 45.0).abs() < 1e-9, "{w}x{h}: {angle}°");
+        }
+        // One row has no row-to-row angle: it is taken as the full field.
         assert_eq!(fov_from_nff_angle(45.0, 1), 45.0);
     }
 

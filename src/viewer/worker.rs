@@ -670,3 +670,86 @@ pub fn rgb_to_rgba(rgb: &[u8]) -> Vec<u8> {
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn resampling_picks_the_nearest_source_pixel() {
+        // A 2x2 image of four colours, doubled: each becomes a 2x2 block.
+        let rgba: Vec<u8> = (0..4u8).flat_map(|k| [k, 10 * k, 20 * k, 255]).collect();
+        let big = resample_rgba(&rgba, 2, 2, 4, 4);
+        let at = |x: usize, y: usize| big[(y * 4 + x) * 4];
+        let blocks: Vec<u8> = (0..4)
+            .flat_map(|y| (0..4).map(move |x| (x, y)))
+            .map(|(x, y)| at(x, y))
+            .collect();
+        assert_eq!(blocks, [0, 0, 1, 1, 0, 0, 1, 1, 2, 2, 3, 3, 2, 2, 3, 3]);
+        // Halved back: the top-left pixel of each block.
+        assert_eq!(resample_rgba(&big, 4, 4, 2, 2), rgba);
+        // Nothing usable (a buffer of another size): opaque black.
+        assert_eq!(resample_rgba(&rgba, 3, 3, 1, 1), [0, 0, 0, 255]);
+    }
+
+    #[test]
+    fn a_tile_of_the_shaded_view_encodes_like_the_whole_frame() {
+        let settings = RenderSettings {
+            width: 3,
+            height: 1,
+            samples: 1,
+            max_depth: 5,
+            use_octree: true,
+            view: ViewMode::Shaded,
+            protocol: crate::settings::Protocol::Glint,
+            colors: crate::color::ColorConvention::Linear,
+            sides: crate::settings::Sides::Two,
+            adaptive: false,
+            shadows: true,
+        };
+        let values = [
+            DVec3::new(0.0, 0.5, 1.0),
+            DVec3::new(2.0, -1.0, 0.25),
+            DVec3::splat(0.0031308),
+        ];
+        let range = Mutex::new((f64::INFINITY, f64::NEG_INFINITY));
+        let tile = tile_rgba(&values, &settings, &range);
+        // sRGB encoding (IEC 61966-2-1) of each channel, clamped to [0, 1].
+        let srgb = |x: f64| {
+            let x = x.clamp(0.0, 1.0);
+            let e = if x <= 0.0031308 {
+                12.92 * x
+            } else {
+                1.055 * x.powf(1.0 / 2.4) - 0.055
+            };
+            (e * 255.0).round() as u8
+        };
+        let expected: Vec<u8> = values
+            .iter()
+            .flat_map(|v| [srgb(v.x), srgb(v.y), srgb(v.z), 255])
+            .collect();
+        assert_eq!(tile, expected);
+    }
+
+    #[test]
+    fn passes_describe_what_they_dropped() {
+        let preview = Preview {
+            divisor: 2,
+            reflections: false,
+            shadows: true,
+        };
+        assert_eq!(
+            PassKind::Preview(preview).label(),
+            "preview 1/2, no reflections"
+        );
+        let bare = Preview {
+            divisor: 1,
+            reflections: false,
+            shadows: false,
+        };
+        assert_eq!(
+            bare.describe(),
+            "full resolution, no reflections, no shadows"
+        );
+    }
+}
