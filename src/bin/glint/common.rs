@@ -178,7 +178,7 @@ pub struct OctreeArgs {
     pub octree_max_duplication: Option<u32>,
     /// Memory budget of the octree in MiB (nodes and references, counted
     /// while it is built); past it, nodes stay leaves, which is correct but
-    /// slower. Default 256.
+    /// slower. Default 128.
     #[arg(long, value_name = "MIB", value_parser = clap::value_parser!(u32).range(1..=glint::accel::MAX_MEMORY_BUDGET_MIB as i64))]
     pub octree_memory_budget: Option<u32>,
 }

@@ -66,3 +66,25 @@ fn main() -> std::process::ExitCode {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn the_command_line_definition_is_consistent() {
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn help_states_the_defaults_the_library_uses() {
+        let mut cli = Cli::command();
+        for name in ["render", "bench"] {
+            let command = cli.find_subcommand_mut(name).unwrap();
+            let help = command.render_long_help().to_string();
+            let said = format!("Default {}", glint::accel::DEFAULT_MEMORY_BUDGET_MIB);
+            assert!(help.contains(&said), "{name} --help lacks {said:?}");
+        }
+    }
+}
