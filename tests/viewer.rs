@@ -506,3 +506,23 @@ fn a_budget_preview_drops_what_it_says() {
         (0, 0, 0)
     );
 }
+
+#[test]
+fn a_deep_ray_tree_leaves_the_panels_and_the_image_apart() {
+    // The glass pixel's tree nests four levels of headers, which do not
+    // wrap; once they widened the timing panel and the image slid under it.
+    let source = SceneSource::File(common::repo_path("scenes/glass.toml"));
+    let mut app = GlintApp::new(source, ViewerOptions::default(), || {}).unwrap();
+    app.settings_mut().width = 480;
+    app.settings_mut().height = 360;
+    let mut h = harness(app);
+    let before = h.state().image_rect().unwrap();
+    h.state_mut().inspect_pixel(250, 200);
+    h.run_steps(4);
+    assert_eq!(h.state().inspection().unwrap().tree.depth, 1);
+    let after = h.state().image_rect().unwrap();
+    assert_eq!(after, before, "the image keeps its place");
+    // The fixed-width panels: 330 points each side of a 1200-point window.
+    assert!(after.max.x <= 1200.0 - 330.0, "{after:?}");
+    assert!(after.min.x >= 330.0, "{after:?}");
+}

@@ -6,13 +6,14 @@ use std::sync::Arc;
 
 use egui::{Color32, Pos2, Rect, Sense, Stroke, TextureHandle, TextureOptions};
 
-use super::app::GlintApp;
-use super::worker::PassKind;
-use crate::accel::OctreeCell;
+use super::command::Command;
+use super::state::EditState;
+use super::worker::{PassKind, PassRecord, Worker};
+use crate::accel::{Octree, OctreeCell};
 use crate::camera::Camera;
 use crate::math::DVec3;
 use crate::ray_tree::{RayKind, RayNode};
-use crate::render::Renderer;
+use crate::render::{RenderError, Renderer};
 use crate::settings::{RenderSettings, ViewMode};
 
 /// The inspected pixel and the tree of rays its centre ray spawned.
@@ -79,26 +80,16 @@ pub struct Compare {
 }
 
 /// Run-time state of the inspection tools (none of it restarts a render).
+#[derive(Default)]
 pub struct InspectState {
     /// Octree overlay down to this level; `None` hides it.
     pub overlay_depth: Option<u32>,
-    pub(crate) cells: Option<(usize, u32, Arc<Vec<OctreeCell>>)>,
+    /// The overlay's cells, for the octree at this address and this depth.
+    cells: Option<(usize, u32, Arc<Vec<OctreeCell>>)>,
     /// Clicking the image picks a pixel (Ctrl+click does so any time).
     pub inspect_mode: bool,
     pub inspection: Option<Inspection>,
     pub compare: Option<Compare>,
-}
-
-impl Default for InspectState {
-    fn default() -> Self {
-        Self {
-            overlay_depth: None,
-            cells: None,
-            inspect_mode: false,
-            inspection: None,
-            compare: None,
-        }
-    }
 }
 
 fn to_screen(image_rect: Rect, width: u32, height: u32, (x, y): (f64, f64)) -> Pos2 {
@@ -112,59 +103,83 @@ fn color32(c: [u8; 3]) -> Color32 {
     Color32::from_rgb(c[0], c[1], c[2])
 }
 
-impl GlintApp {
-    /// The octree cells for the overlay at the current depth (cached).
-    fn overlay_cells(&mut self, depth: u32) -> Arc<Vec<OctreeCell>> {
-        let key = Arc::as_ptr(&self.octree) as usize;
-        if let Some((k, d, cells)) = &self.inspect.cells
+/// The passes of generation `generation` that count (no previews), e.g.
+/// "1 sample 0.120 s, 16 samples 1.530 s".
+pub fn timing_label(history: &[PassRecord], generation: u64) -> String {
+    let parts: Vec<String> = history
+        .iter()
+        .filter(|r| r.generation == generation && !matches!(r.kind, PassKind::Preview(_)))
+        .map(|r| format!("{} {:.3} s", r.kind.label(), r.seconds))
+        .collect();
+    if parts.is_empty() {
+        "not finished".into()
+    } else {
+        parts.join(", ")
+    }
+}
+
+impl InspectState {
+    pub fn new(overlay_depth: Option<u32>) -> Self {
+        Self {
+            overlay_depth,
+            ..Self::default()
+        }
+    }
+
+    /// The octree cells for the overlay at `depth` (cached per octree).
+    fn overlay_cells(&mut self, octree: &Arc<Octree>, depth: u32) -> Arc<Vec<OctreeCell>> {
+        let key = Arc::as_ptr(octree) as usize;
+        if let Some((k, d, cells)) = &self.cells
             && *k == key
             && *d == depth
         {
             return Arc::clone(cells);
         }
-        let cells = Arc::new(self.octree.cells(depth));
-        self.inspect.cells = Some((key, depth, Arc::clone(&cells)));
+        let cells = Arc::new(octree.cells(depth));
+        self.cells = Some((key, depth, Arc::clone(&cells)));
         cells
     }
 
-    /// Picks pixel `(i, j)` and traces its ray tree on this thread: one
-    /// pixel is microseconds of work.
-    pub fn inspect_pixel(&mut self, i: u32, j: u32) {
+    /// Picks pixel `(i, j)` of the image `edit` describes and traces its
+    /// centre ray's tree on this thread: one pixel is microseconds of work.
+    /// A pixel outside the image picks nothing.
+    pub fn inspect_pixel(
+        &mut self,
+        edit: &EditState,
+        octree: &Octree,
+        (i, j): (u32, u32),
+    ) -> Result<(), RenderError> {
         let settings = RenderSettings {
             samples: 1,
             view: ViewMode::Shaded,
-            ..self.settings
+            ..edit.settings
         };
         if i >= settings.width || j >= settings.height {
-            return;
+            return Ok(());
         }
-        match Renderer::with_camera(&self.scene, &self.octree, settings, &self.camera) {
-            Ok(r) => {
-                self.inspect.inspection = Some(Inspection {
-                    pixel: (i, j),
-                    tree: r.ray_tree(i, j),
-                    lights: self.scene.lights.iter().map(|l| l.position).collect(),
-                })
-            }
-            Err(e) => self.say(format!("cannot inspect: {e}"), true),
-        }
+        let renderer = Renderer::with_camera(&edit.scene, octree, settings, &edit.camera)?;
+        self.inspection = Some(Inspection {
+            pixel: (i, j),
+            tree: renderer.ray_tree(i, j),
+            lights: edit.scene.lights.iter().map(|l| l.position).collect(),
+        });
+        Ok(())
     }
 
-    /// Keeps the frame on screen as "A".
-    pub fn pin_as_a(&mut self) {
-        let (width, height, rgba, generation) = self
-            .worker
-            .with_buffer(|b| (b.width, b.height, b.rgba.clone(), b.generation));
+    /// Keeps the frame on screen as "A", labelled with its settings.
+    pub fn pin_as_a(&mut self, worker: &Worker, label: String) {
+        let (width, height, rgba, generation) =
+            worker.with_buffer(|b| (b.width, b.height, b.rgba.clone(), b.generation));
         if width == 0 {
             return;
         }
-        self.inspect.compare = Some(Compare {
+        self.compare = Some(Compare {
             pinned: Pinned {
                 width,
                 height,
                 rgba,
-                label: self.settings_label(),
-                timing: self.timing_label(generation),
+                label,
+                timing: timing_label(&worker.history(), generation),
             },
             mode: CompareMode::Split,
             divider: 0.5,
@@ -175,40 +190,12 @@ impl GlintApp {
         });
     }
 
-    pub fn settings_label(&self) -> String {
-        let s = &self.settings;
-        format!(
-            "{}, AA {}, octree {}, depth {}, {}x{}",
-            s.view.name(),
-            if self.anti_aliasing { "on" } else { "off" },
-            if s.use_octree { "on" } else { "off" },
-            s.max_depth,
-            s.width,
-            s.height
-        )
-    }
-
-    fn timing_label(&self, generation: u64) -> String {
-        let parts: Vec<String> = self
-            .worker
-            .history()
-            .iter()
-            .filter(|r| r.generation == generation && !matches!(r.kind, PassKind::Preview(_)))
-            .map(|r| format!("{} {:.3} s", r.kind.label(), r.seconds))
-            .collect();
-        if parts.is_empty() {
-            "not finished".into()
-        } else {
-            parts.join(", ")
-        }
-    }
-
     /// A versus B, when B is complete: the pixels that differ.
-    pub fn compare_stats(&self) -> Option<DiffStats> {
-        let c = self.inspect.compare.as_ref()?;
-        let generation = self.worker.generation();
+    pub fn compare_stats(&self, worker: &Worker) -> Option<DiffStats> {
+        let c = self.compare.as_ref()?;
+        let generation = worker.generation();
         let cached = c.stats.get();
-        let result = self.worker.with_buffer(|b| {
+        let result = worker.with_buffer(|b| {
             if let Some((version, stats)) = cached
                 && version == b.version
             {
@@ -227,17 +214,17 @@ impl GlintApp {
 
     /// Draws A over the live image (split or difference) where a comparison
     /// is active; returns whether it drew the image itself.
-    pub(crate) fn compare_image_ui(
+    pub fn compare_image_ui(
         &mut self,
         ui: &mut egui::Ui,
         image_rect: Rect,
         live: Option<&TextureHandle>,
+        worker: &Worker,
     ) -> bool {
-        let Some(c) = &mut self.inspect.compare else {
+        let Some(c) = &mut self.compare else {
             return false;
         };
-        let (w, h) = self
-            .worker
+        let (w, h) = worker
             .try_with_buffer(|b| (b.width, b.height))
             .unwrap_or((0, 0));
         if (w, h) != (c.pinned.width, c.pinned.height) {
@@ -274,7 +261,6 @@ impl GlintApp {
                     Rect::from_min_max(Pos2::new(c.divider, 0.0), Pos2::new(1.0, 1.0)),
                     Color32::WHITE,
                 );
-                let _ = full;
                 // The divider: a handle that takes drags before the camera does.
                 let handle = Rect::from_center_size(
                     Pos2::new(x, image_rect.center().y),
@@ -295,25 +281,18 @@ impl GlintApp {
                     ],
                     Stroke::new(2.0, Color32::WHITE),
                 );
-                for (text, pos, align) in [
-                    ("A", image_rect.left_top(), egui::Align2::LEFT_TOP),
-                    ("B", image_rect.right_top(), egui::Align2::RIGHT_TOP),
+                // Labels inset from the top corners.
+                for (text, pos, align, inset) in [
+                    ("A", image_rect.left_top(), egui::Align2::LEFT_TOP, 6.0),
+                    ("B", image_rect.right_top(), egui::Align2::RIGHT_TOP, -6.0),
                 ] {
-                    let r = painter.text(
-                        pos + egui::vec2(
-                            if align == egui::Align2::LEFT_TOP {
-                                6.0
-                            } else {
-                                -6.0
-                            },
-                            4.0,
-                        ),
+                    painter.text(
+                        pos + egui::vec2(inset, 4.0),
                         align,
                         text,
                         egui::FontId::proportional(18.0),
                         Color32::WHITE,
                     );
-                    let _ = r;
                 }
             }
             CompareMode::Difference => {
@@ -321,8 +300,7 @@ impl GlintApp {
                 // changed; a busy buffer is simply tried again next frame.
                 let gain_key = c.gain.to_bits();
                 let cached = c.diff_texture.as_ref().map(|(v, g, _)| (*v, *g));
-                let fresh = self
-                    .worker
+                let fresh = worker
                     .try_with_buffer(|b| {
                         let size_ok = (b.width, b.height) == (c.pinned.width, c.pinned.height)
                             && b.rgba.len() == c.pinned.rgba.len();
@@ -356,14 +334,20 @@ impl GlintApp {
     }
 
     /// Overlay and ray-tree drawings over the image, and the hover read-out.
-    pub(crate) fn overlays_ui(&mut self, ui: &mut egui::Ui, image_rect: Rect) {
-        let (w, h) = (self.settings.width, self.settings.height);
-        let Ok(camera) = Camera::new(&self.camera, w, h) else {
+    pub fn overlays_ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        image_rect: Rect,
+        edit: &EditState,
+        octree: &Arc<Octree>,
+    ) {
+        let (w, h) = (edit.settings.width, edit.settings.height);
+        let Ok(camera) = Camera::new(&edit.camera, w, h) else {
             return;
         };
         let painter = ui.painter_at(image_rect);
-        if let Some(depth) = self.inspect.overlay_depth {
-            let cells = self.overlay_cells(depth);
+        if let Some(depth) = self.overlay_depth {
+            let cells = self.overlay_cells(octree, depth);
             for (cell, color) in crate::overlay::styled_cells(&cells) {
                 let color = color32(color);
                 for (a, b) in crate::overlay::cell_segments(&camera, cell) {
@@ -403,8 +387,8 @@ impl GlintApp {
                 }
             }
         }
-        if let Some(ins) = &self.inspect.inspection {
-            let extent = self.scene.extent_bounds().extent().length().max(1e-9);
+        if let Some(ins) = &self.inspection {
+            let extent = edit.scene.extent_bounds().extent().length().max(1e-9);
             draw_tree(
                 &painter,
                 &camera,
@@ -502,8 +486,8 @@ fn rgb_text(c: [f64; 3]) -> String {
 }
 
 /// The inspected pixel's ray tree as nested, collapsible rows.
-pub fn ray_tree_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
-    let Some(ins) = &app.inspect.inspection else {
+pub fn ray_tree_ui(inspect: &InspectState, ui: &mut egui::Ui) {
+    let Some(ins) = &inspect.inspection else {
         ui.label("Ctrl+click the image (or turn on Inspect and click) to see a pixel's rays.");
         return;
     };
@@ -569,36 +553,40 @@ fn node_ui(ui: &mut egui::Ui, node: &RayNode, path: &str) {
     });
 }
 
-/// The overlay, inspect and A/B controls.
-pub fn inspect_controls_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
-    let mut overlay = app.inspect.overlay_depth.is_some();
+/// The overlay, inspect and A/B controls. `label` describes the current
+/// settings (B's); "Pin as A" is returned as a command, since pinning needs
+/// the app's settings label at the moment it is applied.
+pub fn inspect_controls_ui(
+    inspect: &mut InspectState,
+    worker: &Worker,
+    label: &str,
+    ui: &mut egui::Ui,
+) -> Vec<Command> {
+    let mut commands = Vec::new();
+    let mut overlay = inspect.overlay_depth.is_some();
     ui.horizontal(|ui| {
         ui.checkbox(&mut overlay, "Octree overlay");
-        let mut depth = app.inspect.overlay_depth.unwrap_or(3);
+        let mut depth = inspect.overlay_depth.unwrap_or(3);
         ui.label("to depth");
         ui.add(egui::DragValue::new(&mut depth).range(0..=crate::accel::MAX_OCTREE_DEPTH));
-        app.inspect.overlay_depth = overlay.then_some(depth);
+        inspect.overlay_depth = overlay.then_some(depth);
     });
-    ui.checkbox(
-        &mut app.inspect.inspect_mode,
-        "Inspect: click picks a pixel",
-    );
-    if app.inspect.inspection.is_some() && ui.button("Clear inspected pixel").clicked() {
-        app.inspect.inspection = None;
+    ui.checkbox(&mut inspect.inspect_mode, "Inspect: click picks a pixel");
+    if inspect.inspection.is_some() && ui.button("Clear inspected pixel").clicked() {
+        inspect.inspection = None;
     }
     ui.separator();
     ui.horizontal(|ui| {
         if ui.button("Pin as A").clicked() {
-            app.pin_as_a();
+            commands.push(Command::PinAsA);
         }
-        if app.inspect.compare.is_some() && ui.button("Unpin").clicked() {
-            app.inspect.compare = None;
+        if inspect.compare.is_some() && ui.button("Unpin").clicked() {
+            inspect.compare = None;
         }
     });
-    let stats = app.compare_stats();
-    let label = app.settings_label();
-    let b_timing = app.timing_label(app.worker.generation());
-    if let Some(c) = &mut app.inspect.compare {
+    let stats = inspect.compare_stats(worker);
+    let b_timing = timing_label(&worker.history(), worker.generation());
+    if let Some(c) = &mut inspect.compare {
         ui.horizontal(|ui| {
             ui.selectable_value(&mut c.mode, CompareMode::Split, "Split");
             ui.selectable_value(&mut c.mode, CompareMode::Difference, "Difference");
@@ -636,5 +624,65 @@ pub fn inspect_controls_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                 ui.label("B is rendering (or has another size)…");
             }
         }
+    }
+    commands
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::stats::RayCounts;
+
+    #[test]
+    fn differences_count_pixels_and_the_largest_channel_step() {
+        let a = [10, 20, 30, 255, 0, 0, 0, 255, 5, 5, 5, 255];
+        // Pixel 0 equal; pixel 1 differs by 7 in blue; pixel 2 by 3 in red
+        // (alpha is not compared).
+        let b = [10, 20, 30, 0, 0, 0, 7, 255, 8, 5, 5, 255];
+        assert_eq!(
+            diff_stats(&a, &b),
+            DiffStats {
+                differing: 2,
+                total: 3,
+                largest: 7
+            }
+        );
+        assert_eq!(diff_stats(&a, &a).differing, 0);
+    }
+
+    #[test]
+    fn timing_labels_list_the_full_passes_of_one_generation() {
+        let pass = |generation, kind, seconds| PassRecord {
+            generation,
+            kind,
+            seconds,
+            rays: RayCounts::default(),
+            octree: true,
+            anti_aliasing: true,
+            width: 8,
+            height: 8,
+            finished_at: 0.0,
+            one_sample_error: None,
+            refined_pixels: None,
+            view: ViewMode::Shaded,
+            max_depth: 5,
+            protocol: crate::settings::Protocol::Glint,
+        };
+        let preview = PassKind::Preview(super::super::worker::Preview {
+            divisor: 2,
+            reflections: true,
+            shadows: true,
+        });
+        let history = [
+            pass(1, PassKind::OneSample, 0.5),
+            pass(2, preview, 0.01),
+            pass(2, PassKind::OneSample, 0.125),
+            pass(2, PassKind::SixteenSamples, 1.5),
+        ];
+        assert_eq!(
+            timing_label(&history, 2),
+            "1 sample 0.125 s, 16 samples 1.500 s"
+        );
+        assert_eq!(timing_label(&history, 3), "not finished");
     }
 }

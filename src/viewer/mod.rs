@@ -1,11 +1,20 @@
 //! The interactive viewer (cargo feature `gui`): a layer over the headless
-//! renderer. [`app::GlintApp`] holds what the user edits; [`worker::Worker`]
-//! renders in the background.
+//! renderer. [`GlintApp`] holds what the user edits ([`state::EditState`])
+//! and the runtime that shows it; [`worker::Worker`] renders in the
+//! background. Panels and input return [`command::Command`]s that the app
+//! applies once per frame.
 
 pub mod app;
+mod budget;
+pub mod command;
+mod export;
+mod input;
 pub mod inspect;
 mod orbit;
 mod panels;
+mod screenshot;
+pub mod state;
 pub mod worker;
 
-pub use app::{GlintApp, SceneSource, ViewerOptions};
+pub use app::{GlintApp, ViewerOptions};
+pub use state::SceneSource;

@@ -1,44 +1,68 @@
-//! The viewer's panels. Each `*_ui` function draws one panel and edits the
-//! app's state; actions that do I/O are queued as commands.
+//! The viewer's panels. Each `*_ui` function draws one panel from the
+//! state it is given: it edits plain state (settings, camera, lights) in
+//! place and returns the actions the user asked for as [`Command`]s, which
+//! the app applies after the frame.
 
 use egui::{Color32, DragValue, RichText};
 use egui_plot::{Legend, Line, Plot, Points};
 
-use super::app::{Command, GlintApp};
-use super::worker::PassKind;
+use super::command::Command;
+use super::inspect::InspectState;
+use super::state::EditState;
+use super::worker::{PassKind, PassRecord, Preview, Worker};
+use crate::accel::Octree;
 use crate::color::ColorConvention;
 use crate::math::DVec3;
 use crate::settings::{Protocol, RenderSettings, Sides, ViewMode};
 
-pub fn menu_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
+/// A message shown in the status bar.
+#[derive(Clone, Debug)]
+pub struct Message {
+    pub text: String,
+    pub is_error: bool,
+}
+
+/// What the timing and status panels report besides the edited state.
+pub struct RenderInfo<'a> {
+    pub worker: &'a Worker,
+    pub octree: &'a Octree,
+    pub build_seconds: f64,
+    /// The preview chosen for the last drag, and its estimated seconds.
+    pub last_preview: Option<(Preview, f64)>,
+    pub message: Option<&'a Message>,
+}
+
+pub fn menu_ui(scene_name: &str, ui: &mut egui::Ui) -> Vec<Command> {
+    let mut commands = Vec::new();
     egui::MenuBar::new().ui(ui, |ui| {
         ui.menu_button("File", |ui| {
             if ui.button("Open scene…  (Ctrl+O)").clicked() {
-                app.commands.push(Command::Open);
+                commands.push(Command::Open);
                 ui.close();
             }
             if ui.button("Reload  (F5)").clicked() {
-                app.commands.push(Command::Reload);
+                commands.push(Command::Reload);
                 ui.close();
             }
             if ui.button("Export PNG…  (Ctrl+S)").clicked() {
-                app.commands.push(Command::Export);
+                commands.push(Command::Export);
                 ui.close();
             }
             ui.separator();
             if ui.button("Quit").clicked() {
-                ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);
+                commands.push(Command::Quit);
             }
         });
         ui.menu_button("View", |ui| {
             if ui.button("Reset camera  (R)").clicked() {
-                app.commands.push(Command::ResetCamera);
+                commands.push(Command::ResetCamera);
                 ui.close();
             }
         });
         ui.separator();
-        ui.label(RichText::new(&app.scene.name).weak());
+        ui.label(RichText::new(scene_name).weak());
     });
+    commands
 }
 
 fn vec3_ui(ui: &mut egui::Ui, label: &str, v: &mut DVec3, speed: f64) -> bool {
@@ -74,18 +98,25 @@ fn color_ui(ui: &mut egui::Ui, label: &str, c: &mut DVec3) -> bool {
     changed
 }
 
-pub fn controls_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
+/// Render settings, the inspection tools, camera, lights and materials.
+pub fn controls_ui(
+    edit: &mut EditState,
+    inspect: &mut InspectState,
+    worker: &Worker,
+    ui: &mut egui::Ui,
+) -> Vec<Command> {
+    let mut commands = Vec::new();
     egui::ScrollArea::vertical().show(ui, |ui| {
-        let extent = app.scene.extent_bounds().extent().max_element().max(1e-9);
+        let extent = edit.scene.extent_bounds().extent().max_element().max(1e-9);
         let speed = extent * 0.002;
 
         egui::CollapsingHeader::new("Render settings")
             .default_open(true)
             .show(ui, |ui| {
-                let spd = app.settings.protocol == Protocol::Spd;
+                let spd = edit.settings.protocol == Protocol::Spd;
                 ui.horizontal(|ui| {
                     ui.label("Protocol");
-                    let mut protocol = app.settings.protocol;
+                    let mut protocol = edit.settings.protocol;
                     for p in Protocol::ALL {
                         ui.selectable_value(&mut protocol, p, p.name())
                             .on_hover_text(match p {
@@ -93,30 +124,30 @@ pub fn controls_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                                 Protocol::Spd => "the SPD test protocol: rays through the pixel corners, depth 5, a reflection ray from every reflective or transmitting surface, opaque surfaces one-sided",
                             });
                     }
-                    if protocol != app.settings.protocol {
-                        app.settings = match protocol {
+                    if protocol != edit.settings.protocol {
+                        edit.settings = match protocol {
                             // Back to glint's rules: the scene's own depth and sidedness.
                             Protocol::Glint => RenderSettings {
                                 protocol,
-                                max_depth: app.scene.image.max_depth,
-                                sides: app.scene.image.sides,
-                                ..app.settings
+                                max_depth: edit.scene.image.max_depth,
+                                sides: edit.scene.image.sides,
+                                ..edit.settings
                             },
-                            Protocol::Spd => app.settings.with_protocol(protocol),
+                            Protocol::Spd => edit.settings.with_protocol(protocol),
                         };
                     }
                 });
                 ui.add_enabled(
                     !spd,
                     egui::Checkbox::new(
-                        &mut app.anti_aliasing,
+                        &mut edit.anti_aliasing,
                         "Anti-aliasing (16 samples, 4x4 grid)",
                     ),
                 );
                 ui.add_enabled(
-                    !spd && app.anti_aliasing,
+                    !spd && edit.anti_aliasing,
                     egui::Checkbox::new(
-                        &mut app.settings.adaptive,
+                        &mut edit.settings.adaptive,
                         "only where the picture needs it (adaptive)",
                     ),
                 )
@@ -124,18 +155,18 @@ pub fn controls_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                     "trace every pixel's centre, then the 4x4 grid only where neighbours differ: \
                      another material, a shadow edge, a visible contrast",
                 );
-                ui.checkbox(&mut app.settings.use_octree, "Octree");
+                ui.checkbox(&mut edit.settings.use_octree, "Octree");
                 ui.horizontal(|ui| {
                     ui.label("Max depth");
                     ui.add_enabled(
                         !spd,
-                        DragValue::new(&mut app.settings.max_depth).range(1..=64),
+                        DragValue::new(&mut edit.settings.max_depth).range(1..=64),
                     );
                 });
                 ui.horizontal(|ui| {
                     ui.label("Colours");
                     for c in ColorConvention::ALL {
-                        ui.selectable_value(&mut app.settings.colors, c, c.name())
+                        ui.selectable_value(&mut edit.settings.colors, c, c.name())
                             .on_hover_text(match c {
                                 ColorConvention::Linear => "shade in linear light, show sRGB-encoded",
                                 ColorConvention::Display => "shade display values, show them unchanged (the SPD's pictures)",
@@ -145,7 +176,7 @@ pub fn controls_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                 ui.horizontal(|ui| {
                     ui.label("Sides");
                     for side in Sides::ALL {
-                        ui.selectable_value(&mut app.settings.sides, side, side.name())
+                        ui.selectable_value(&mut edit.settings.sides, side, side.name())
                             .on_hover_text(match side {
                                 Sides::Two => "every surface seen from both sides",
                                 Sides::One => "opaque surfaces seen from outside only (patches with vertex normals stay two-sided)",
@@ -155,7 +186,7 @@ pub fn controls_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                 ui.horizontal(|ui| {
                     ui.label("Frame budget while moving");
                     ui.add(
-                        DragValue::new(&mut app.frame_budget_ms)
+                        DragValue::new(&mut edit.frame_budget_ms)
                             .range(5.0..=1000.0)
                             .speed(1.0)
                             .suffix(" ms"),
@@ -167,26 +198,29 @@ pub fn controls_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                 });
                 ui.horizontal(|ui| {
                     ui.label("Image size");
-                    ui.add(DragValue::new(&mut app.settings.width).range(1..=8192));
+                    ui.add(DragValue::new(&mut edit.settings.width).range(1..=8192));
                     ui.label("x");
-                    ui.add(DragValue::new(&mut app.settings.height).range(1..=8192));
+                    ui.add(DragValue::new(&mut edit.settings.height).range(1..=8192));
                 });
                 ui.horizontal_wrapped(|ui| {
                     ui.label("View");
                     for v in ViewMode::ALL {
-                        ui.selectable_value(&mut app.settings.view, v, v.name());
+                        ui.selectable_value(&mut edit.settings.view, v, v.name());
                     }
                 });
             });
 
         egui::CollapsingHeader::new("Inspect and compare")
             .default_open(true)
-            .show(ui, |ui| super::inspect::inspect_controls_ui(app, ui));
+            .show(ui, |ui| {
+                let label = edit.settings_label();
+                commands.extend(super::inspect::inspect_controls_ui(inspect, worker, &label, ui));
+            });
 
         egui::CollapsingHeader::new("Camera")
             .default_open(true)
             .show(ui, |ui| {
-                let mut c = app.camera;
+                let mut c = edit.camera;
                 vec3_ui(ui, "eye", &mut c.eye, speed);
                 vec3_ui(ui, "lookat", &mut c.lookat, speed);
                 vec3_ui(ui, "up", &mut c.up, 0.01);
@@ -200,32 +234,32 @@ pub fn controls_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                     );
                 });
                 // Apply only cameras the renderer accepts (up not parallel to the view).
-                if c != app.camera && crate::camera::Camera::new(&c, 2, 2).is_ok() {
-                    app.camera = c;
+                if c != edit.camera && crate::camera::Camera::new(&c, 2, 2).is_ok() {
+                    edit.camera = c;
                 }
                 if ui.button("Reset camera (R)").clicked() {
-                    app.commands.push(Command::ResetCamera);
+                    commands.push(Command::ResetCamera);
                 }
             });
 
         egui::CollapsingHeader::new("Lights")
             .default_open(true)
             .show(ui, |ui| {
-                for i in 0..app.scene.lights.len() {
-                    let mut light = app.scene.lights[i].clone();
+                for i in 0..edit.scene.lights.len() {
+                    let mut light = edit.scene.lights[i].clone();
                     ui.label(format!("Light {}", i + 1));
                     let mut changed = vec3_ui(ui, "position", &mut light.position, speed);
                     changed |= color_ui(ui, "colour", &mut light.color);
                     if changed {
-                        app.scene_mut().lights[i] = light;
+                        edit.scene_mut().lights[i] = light;
                     }
                     ui.separator();
                 }
             });
 
         ui.collapsing("Materials", |ui| {
-            for i in 0..app.scene.materials.len() {
-                let mut m = app.scene.materials[i].clone();
+            for i in 0..edit.scene.materials.len() {
+                let mut m = edit.scene.materials[i].clone();
                 let mut changed = false;
                 egui::CollapsingHeader::new(&m.name)
                     .id_salt(("material", i))
@@ -253,27 +287,31 @@ pub fn controls_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                             });
                     });
                 if changed {
-                    app.scene_mut().materials[i] = m;
+                    edit.scene_mut().materials[i] = m;
                 }
             }
         });
     });
+    commands
 }
 
-pub fn timing_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
-    egui::ScrollArea::vertical().show(ui, |ui| {
-        timing_grid_ui(app, ui);
-        legend_ui(app, ui);
+/// Pass times and ray counts, the octree's figures, the view's legend and
+/// the inspected pixel's ray tree.
+pub fn timing_ui(edit: &EditState, info: &RenderInfo, inspect: &InspectState, ui: &mut egui::Ui) {
+    // Scrolls both ways: a deep ray tree's headers (which do not wrap) must
+    // not widen the fixed-width panel over the image.
+    egui::ScrollArea::both().show(ui, |ui| {
+        timing_grid_ui(edit, info, ui);
+        legend_ui(info.worker, ui);
         ui.separator();
         ui.heading("Pixel");
-        super::inspect::ray_tree_ui(app, ui);
+        super::inspect::ray_tree_ui(inspect, ui);
     });
 }
 
 /// The colour scale of the cost and aa-need views, from the shown frame.
-fn legend_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
-    let legend = app
-        .worker()
+fn legend_ui(worker: &Worker, ui: &mut egui::Ui) {
+    let legend = worker
         .try_with_buffer(|b| b.last_frame.as_ref().and_then(|f| f.legend()))
         .flatten();
     let Some(legend) = legend else { return };
@@ -301,8 +339,8 @@ fn legend_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
     });
 }
 
-fn timing_grid_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
-    let history = app.worker().history();
+fn timing_grid_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
+    let history = info.worker.history();
     ui.heading("Timing");
     // Figures compare passes of one image only: those of the newest
     // generation that has a full pass (a preview is not one), so a toggle
@@ -318,7 +356,7 @@ fn timing_grid_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
             .rev()
             .find(|r| Some(r.generation) == shown && r.kind == kind)
     };
-    let rendering = app.worker().generation() != shown.unwrap_or(0);
+    let rendering = info.worker.generation() != shown.unwrap_or(0);
     egui::Grid::new("timing-grid")
         .num_columns(2)
         .max_col_width(170.0)
@@ -340,7 +378,7 @@ fn timing_grid_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                     "1-sample pass",
                     one.map_or(pending.into(), |r| format!("{:.3} s", r.seconds)),
                 );
-                if app.anti_aliasing() || sixteen.is_some() {
+                if edit.anti_aliasing || sixteen.is_some() {
                     row(
                         "16-sample pass",
                         sixteen.map_or(pending.into(), |r| format!("{:.3} s", r.seconds)),
@@ -377,7 +415,7 @@ fn timing_grid_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                     }
                 }
             }
-            if let Some((p, estimate)) = app.last_preview {
+            if let Some((p, estimate)) = info.last_preview {
                 let measured = history
                     .iter()
                     .rev()
@@ -390,7 +428,7 @@ fn timing_grid_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                             p.describe(),
                             1000.0 * r.seconds,
                             1000.0 * estimate,
-                            app.frame_budget_ms
+                            edit.frame_budget_ms
                         ),
                         None => format!("{} (est. {:.0} ms)", p.describe(), 1000.0 * estimate),
                     },
@@ -406,8 +444,8 @@ fn timing_grid_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                 row("rays: reflection", format!("{}", r.rays.reflection));
                 row("rays: refraction", format!("{}", r.rays.refraction));
             }
-            let stats = app.octree.stats();
-            row("octree build", format!("{:.3} s", app.build_seconds));
+            let stats = info.octree.stats();
+            row("octree build", format!("{:.3} s", info.build_seconds));
             row(
                 "octree nodes",
                 format!("{} ({} leaves)", stats.nodes, stats.leaves),
@@ -416,7 +454,7 @@ fn timing_grid_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                 "octree memory",
                 format!("{:.1} KiB", stats.memory_bytes as f64 / 1024.0),
             );
-            row("shapes", format!("{}", app.scene.shapes.len()));
+            row("shapes", format!("{}", edit.scene.shapes.len()));
         });
     ui.separator();
     pass_plot_ui(&history, ui);
@@ -438,7 +476,7 @@ fn round_step(x: f64) -> f64 {
 /// Every full pass of the session, one series per octree and anti-aliasing
 /// setting so each toggle shows as a jump between series, on a logarithmic
 /// time axis (a 100 s pass with the octree off must not flatten the rest).
-fn pass_plot_ui(history: &[crate::viewer::worker::PassRecord], ui: &mut egui::Ui) {
+fn pass_plot_ui(history: &[PassRecord], ui: &mut egui::Ui) {
     ui.label("Pass times this session (log scale)");
     let series = [
         (
@@ -534,10 +572,11 @@ fn pass_plot_ui(history: &[crate::viewer::worker::PassRecord], ui: &mut egui::Ui
         });
 }
 
-pub fn status_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
+/// Progress of the pass on screen and the newest message.
+pub fn status_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
     ui.horizontal(|ui| {
-        let status = app
-            .worker()
+        let status = info
+            .worker
             .try_with_buffer(|b| (b.pass, b.tiles_done, b.tiles_total, b.finished));
         match status {
             Some((Some(pass), done, total, finished)) => {
@@ -545,8 +584,8 @@ pub fn status_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                     ui.label(format!(
                         "done: {} ({}x{})",
                         pass.label(),
-                        app.settings().width,
-                        app.settings().height
+                        edit.settings.width,
+                        edit.settings.height
                     ));
                 } else {
                     let pct = 100.0 * done as f64 / total.max(1) as f64;
@@ -561,11 +600,11 @@ pub fn status_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
                 ui.label("rendering…");
             }
         }
-        if app.settings().view == ViewMode::AaNeed && !app.anti_aliasing() {
+        if edit.settings.view == ViewMode::AaNeed && !edit.anti_aliasing {
             ui.separator();
             ui.label("aa-need compares the 1- and 16-sample passes: turn anti-aliasing on");
         }
-        if let Some(m) = app.messages().last() {
+        if let Some(m) = info.message {
             ui.separator();
             let color = if m.is_error {
                 Color32::from_rgb(230, 80, 60)
@@ -574,6 +613,5 @@ pub fn status_ui(app: &mut GlintApp, ui: &mut egui::Ui) {
             };
             ui.label(RichText::new(&m.text).color(color));
         }
-        let _ = app.uptime();
     });
 }

@@ -1,0 +1,224 @@
+//! The frame budget while the user drags: which preview (resolution,
+//! reflections, shadows) fits the time, estimated from the passes so far.
+
+use super::worker::{PassKind, PassRecord, Preview};
+use crate::settings::RenderSettings;
+
+/// The preview to render while the user drags: the best image whose estimated time fits the frame budget. Candidates in order
+/// of preference: full, 1/2, 1/4, 1/8 resolution, each first complete,
+/// then without reflections, then without shadows too. Estimates come
+/// from this scene's last full 1-sample pass (its time per pixel, and
+/// its rays by kind for what dropping reflections or shadows saves),
+/// corrected by how far the last preview's estimate was off.
+pub fn choose_preview(
+    history: &[PassRecord],
+    settings: &RenderSettings,
+    budget_ms: f64,
+) -> Option<(Preview, f64)> {
+    let fallback = Preview {
+        divisor: 4,
+        reflections: true,
+        shadows: true,
+    };
+    let Some(base) = history
+        .iter()
+        .rev()
+        .find(|r| matches!(r.kind, PassKind::OneSample | PassKind::Corners))
+    else {
+        return Some((fallback, f64::NAN));
+    };
+    let estimate = |p: &Preview| estimate_preview(base, p, settings);
+    // How far off the model was on the last preview it predicted.
+    let correction = history
+        .iter()
+        .rev()
+        .find_map(|r| match r.kind {
+            PassKind::Preview(p) if r.finished_at > base.finished_at => {
+                Some((r.seconds / estimate(&p)).clamp(0.25, 4.0))
+            }
+            _ => None,
+        })
+        .unwrap_or(1.0);
+    let budget = budget_ms / 1000.0;
+    let candidates = [1u32, 2, 4, 8].into_iter().flat_map(|divisor| {
+        [(true, true), (false, true), (false, false)].map(|(reflections, shadows)| Preview {
+            divisor,
+            reflections,
+            shadows,
+        })
+    });
+    let mut last = None;
+    for p in candidates {
+        let t = estimate(&p) * correction;
+        if t <= budget {
+            return Some((p, t));
+        }
+        last = Some((p, t));
+    }
+    last
+}
+
+/// Estimated seconds of `preview` at the current settings, from the full
+/// 1-sample pass `base`: time per pixel times the pixels, times the share
+/// of its rays the preview still casts (dropping reflections drops the
+/// secondary rays and the shadow rays from their hits).
+fn estimate_preview(base: &PassRecord, preview: &Preview, settings: &RenderSettings) -> f64 {
+    let per_pixel = base.seconds / (base.width as f64 * base.height as f64).max(1.0);
+    let d = preview.divisor as f64;
+    let pixels = (settings.width as f64 / d).max(1.0) * (settings.height as f64 / d).max(1.0);
+    let r = base.rays;
+    let total = r.total().max(1) as f64;
+    let secondary = (r.reflection + r.refraction) as f64;
+    let hits = r.primary_hits as f64;
+    let mut shadow = r.shadow as f64;
+    let mut rays = total;
+    if !preview.reflections {
+        rays -= secondary;
+        // Shadow rays come from primary and secondary hits alike.
+        let kept = shadow * hits / (hits + secondary).max(1.0);
+        rays -= shadow - kept;
+        shadow = kept;
+    }
+    if !preview.shadows {
+        rays -= shadow;
+    }
+    per_pixel * pixels * (rays / total).max(0.05)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::stats::RayCounts;
+
+    fn base() -> PassRecord {
+        PassRecord {
+            generation: 1,
+            kind: PassKind::OneSample,
+            seconds: 0.4,
+            // 100 eye rays, 80 hit; 40 secondary rays; 240 shadow rays.
+            rays: RayCounts {
+                primary: 100,
+                primary_hits: 80,
+                shadow: 240,
+                reflection: 30,
+                refraction: 10,
+                total_internal_reflections: 0,
+            },
+            octree: true,
+            anti_aliasing: false,
+            width: 800,
+            height: 600,
+            finished_at: 1.0,
+            one_sample_error: None,
+            refined_pixels: None,
+            view: crate::settings::ViewMode::Shaded,
+            max_depth: 5,
+            protocol: crate::settings::Protocol::Glint,
+        }
+    }
+
+    fn settings() -> RenderSettings {
+        RenderSettings {
+            width: 800,
+            height: 600,
+            samples: 1,
+            max_depth: 5,
+            use_octree: true,
+            view: crate::settings::ViewMode::Shaded,
+            protocol: crate::settings::Protocol::Glint,
+            colors: crate::color::ColorConvention::Linear,
+            sides: crate::settings::Sides::Two,
+            adaptive: false,
+            shadows: true,
+        }
+    }
+
+    #[test]
+    fn the_budget_picks_the_best_preview_that_fits() {
+        let p = |divisor, reflections, shadows| Preview {
+            divisor,
+            reflections,
+            shadows,
+        };
+        let history = [base()];
+        let choose = |ms| choose_preview(&history, &settings(), ms).map(|(p, _)| p);
+        // The full 1-sample pass took 400 ms.
+        assert_eq!(choose(500.0), Some(p(1, true, true)));
+        // 1/2 resolution: 100 ms; without reflections 100 * 260/380 = 68 ms.
+        assert_eq!(choose(100.0), Some(p(2, true, true)));
+        assert_eq!(choose(70.0), Some(p(2, false, true)));
+        // Resolution goes before effects: 1/2 with neither reflections nor
+        // shadows (100 * 100/380 = 26 ms) before 1/4 (25 ms).
+        assert_eq!(choose(33.0), Some(p(2, false, false)));
+        // 1/4 without reflections: 25 * 260/380 = 17 ms.
+        assert_eq!(choose(20.0), Some(p(4, false, true)));
+        // Nothing fits: the cheapest candidate.
+        assert_eq!(choose(0.001), Some(p(8, false, false)));
+        // No full pass yet: a quarter-resolution guess.
+        assert_eq!(
+            choose_preview(&[], &settings(), 33.0).map(|(p, _)| p),
+            Some(p(4, true, true))
+        );
+    }
+
+    #[test]
+    fn a_preview_slower_than_estimated_corrects_the_next_choice() {
+        // The last 1/4 preview took four times its 25 ms estimate: the
+        // model is scaled by 4, so 1/2 bare (4 x 26 ms) no longer fits 33 ms
+        // and 1/4 bare (4 x 6.6 ms) does.
+        let mut slow = base();
+        slow.kind = PassKind::Preview(Preview {
+            divisor: 4,
+            reflections: true,
+            shadows: true,
+        });
+        slow.seconds = 0.1;
+        slow.finished_at = 2.0;
+        let history = [base(), slow];
+        let (chosen, estimate) = choose_preview(&history, &settings(), 33.0).unwrap();
+        assert_eq!(
+            chosen,
+            Preview {
+                divisor: 4,
+                reflections: false,
+                shadows: false
+            }
+        );
+        assert!(
+            (estimate - 4.0 * 0.4 / 16.0 * 100.0 / 380.0).abs() < 1e-12,
+            "{estimate}"
+        );
+    }
+
+    #[test]
+    fn preview_estimates_scale_with_pixels_and_rays_cast() {
+        let settings = RenderSettings {
+            width: 800,
+            height: 600,
+            samples: 1,
+            max_depth: 5,
+            use_octree: true,
+            view: crate::settings::ViewMode::Shaded,
+            protocol: crate::settings::Protocol::Glint,
+            colors: crate::color::ColorConvention::Linear,
+            sides: crate::settings::Sides::Two,
+            adaptive: false,
+            shadows: true,
+        };
+        let p = |divisor, reflections, shadows| Preview {
+            divisor,
+            reflections,
+            shadows,
+        };
+        let full = estimate_preview(&base(), &p(1, true, true), &settings);
+        assert!((full - 0.4).abs() < 1e-12, "the base pass itself");
+        let half = estimate_preview(&base(), &p(2, true, true), &settings);
+        assert!((half - 0.1).abs() < 1e-12, "a quarter of the pixels");
+        // Without reflections: 100 eye rays and the 240 * 80/120 = 160
+        // shadow rays of eye-ray hits, of 380 rays.
+        let flat = estimate_preview(&base(), &p(1, false, true), &settings);
+        assert!((flat - 0.4 * 260.0 / 380.0).abs() < 1e-12, "{flat}");
+        let bare = estimate_preview(&base(), &p(1, false, false), &settings);
+        assert!((bare - 0.4 * 100.0 / 380.0).abs() < 1e-12, "{bare}");
+    }
+}

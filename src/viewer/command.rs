@@ -1,0 +1,20 @@
+//! What the user asked for in a frame. Panels and shortcuts return commands;
+//! the app applies them once the frame's UI is drawn, so no panel does I/O
+//! or reaches into the app (the pattern of the egui demo and Rerun).
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Command {
+    /// Pick a scene file in a dialog and open it.
+    Open,
+    /// Read the scene file again, keeping the camera.
+    Reload,
+    /// Write the frame on screen to a PNG.
+    Export,
+    /// Back to the scene's camera.
+    ResetCamera,
+    /// Trace pixel `(x, y)`'s ray tree and show it.
+    InspectPixel(u32, u32),
+    /// Keep the frame on screen as "A" of an A/B comparison.
+    PinAsA,
+    Quit,
+}

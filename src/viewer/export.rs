@@ -1,0 +1,169 @@
+//! Exporting the frame on screen to PNG: where it goes (a save dialog, or
+//! the pictures directory where there is none) and what it records.
+
+use std::path::{Path, PathBuf};
+
+use super::state::SceneSource;
+use super::worker::Worker;
+use crate::accel::Octree;
+use crate::export::{RenderRecord, SceneEdits};
+
+/// The path to export to: chosen in a save dialog, or, where no dialog is
+/// available, a timestamped name in a place made for pictures. `None` when
+/// the user cancels the dialog.
+pub fn choose_path(source: &SceneSource) -> Option<PathBuf> {
+    let default_name = format!("{}-{}.png", source.stem(), timestamp());
+    if file_dialog_available() {
+        rfd::FileDialog::new()
+            .set_file_name(&default_name)
+            .add_filter("PNG", &["png"])
+            .save_file()
+    } else {
+        // No dialog (no desktop portal, e.g. under Xvfb): never the working
+        // directory, which is often a checkout.
+        Some(export_dir(source).join(&default_name))
+    }
+}
+
+/// Saves the display buffer with the record of how it was made (see
+/// [`crate::export`]): the scene, camera and settings of the pass on
+/// screen, not the panels' current values. A finished pass is written as
+/// `glint render` writes it (diagnostic views with their legend strip, the
+/// octree overlay drawn in when `overlay_depth` is set); a pass still
+/// sweeping in is written as displayed and recorded as partial.
+pub fn export_to(
+    path: &Path,
+    worker: &Worker,
+    octree: &Octree,
+    source: &SceneSource,
+    overlay_depth: Option<u32>,
+) -> anyhow::Result<()> {
+    let (w, h, rgba, frame, shown, finished) = worker.with_buffer(|b| {
+        (
+            b.width,
+            b.height,
+            b.rgba.clone(),
+            b.last_frame.clone(),
+            b.source.clone(),
+            b.finished,
+        )
+    });
+    let Some(shown) = shown.filter(|_| w > 0 && h > 0) else {
+        anyhow::bail!("nothing has been rendered yet");
+    };
+    let mut record = RenderRecord::new(
+        &shown.scene,
+        &source.display_name(),
+        &shown.camera,
+        shown.settings,
+    );
+    // Lights and materials as rendered (the panels may have edited them).
+    record.settings.edits = Some(SceneEdits {
+        lights: shown.scene.lights.clone(),
+        materials: shown.scene.materials.clone(),
+    });
+    match frame {
+        Some(f) if finished && f.width == w && f.height == h => match overlay_depth {
+            Some(depth) => {
+                record.settings.overlay_depth = Some(depth);
+                let camera = crate::camera::Camera::new(&shown.camera, w, h)?;
+                let cells = octree.cells(depth);
+                let (rgb, height) = crate::overlay::annotate(&f, &camera, &cells, depth);
+                crate::export::save_rgb_png(path, w, height, &rgb, Some(&record))?
+            }
+            None => crate::export::save_png(&f, path, Some(&record))?,
+        },
+        _ => {
+            record.settings.partial = true;
+            let rgb: Vec<u8> = rgba
+                .chunks_exact(4)
+                .flat_map(|p| [p[0], p[1], p[2]])
+                .collect();
+            crate::export::save_rgb_png(path, w, h, &rgb, Some(&record))?
+        }
+    }
+    Ok(())
+}
+
+/// rfd's dialogs go through the XDG desktop portal on D-Bus; without a
+/// session bus (a bare X server such as Xvfb) there is no dialog to show.
+pub fn file_dialog_available() -> bool {
+    std::env::var_os("DBUS_SESSION_BUS_ADDRESS").is_some_and(|v| !v.is_empty())
+}
+
+/// A readable UTC timestamp for file names, e.g. `2026-11-23T14-05-09Z`.
+fn timestamp() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    utc_timestamp(secs)
+}
+
+/// `secs` since the Unix epoch as `YYYY-MM-DDTHH-MM-SSZ` (dashes, not
+/// colons, so the name is valid everywhere). The date from the day count
+/// follows Hinnant's `civil_from_days` ("chrono-Compatible Low-Level Date
+/// Algorithms").
+fn utc_timestamp(secs: u64) -> String {
+    let days = (secs / 86_400) as i64;
+    let rem = secs % 86_400;
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1_460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + (month <= 2) as i64;
+    format!(
+        "{year:04}-{month:02}-{day:02}T{:02}-{:02}-{:02}Z",
+        rem / 3600,
+        rem / 60 % 60,
+        rem % 60
+    )
+}
+
+/// Where exports go without a file dialog: the user's pictures directory
+/// (`XDG_PICTURES_DIR`, from the environment or `~/.config/user-dirs.dirs`,
+/// else `~/Pictures`) if it exists, else the scene file's directory, else
+/// the temporary directory.
+fn export_dir(source: &SceneSource) -> PathBuf {
+    let home = std::env::var_os("HOME").map(PathBuf::from);
+    let from_user_dirs = || {
+        let home = home.as_ref()?;
+        let text = std::fs::read_to_string(home.join(".config/user-dirs.dirs")).ok()?;
+        let line = text
+            .lines()
+            .find(|l| l.trim_start().starts_with("XDG_PICTURES_DIR="))?;
+        let value = line.split_once('=')?.1.trim().trim_matches('"');
+        Some(PathBuf::from(
+            value.replace("$HOME", &home.to_string_lossy()),
+        ))
+    };
+    let pictures = std::env::var_os("XDG_PICTURES_DIR")
+        .map(PathBuf::from)
+        .or_else(from_user_dirs)
+        .or_else(|| home.as_ref().map(|h| h.join("Pictures")));
+    if let Some(dir) = pictures.filter(|d| d.is_dir()) {
+        return dir;
+    }
+    if let SceneSource::File(p) = source
+        && let Some(dir) = p.parent().filter(|d| d.is_dir())
+    {
+        return std::path::absolute(dir).unwrap_or_else(|_| dir.to_owned());
+    }
+    std::env::temp_dir()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn timestamps_are_readable_utc() {
+        assert_eq!(utc_timestamp(0), "1970-01-01T00-00-00Z");
+        // 2000-02-29 (a leap day) 12:34:56 and 2026-11-23 14:05:09.
+        assert_eq!(utc_timestamp(951_827_696), "2000-02-29T12-34-56Z");
+        assert_eq!(utc_timestamp(1_795_442_709), "2026-11-23T14-05-09Z");
+    }
+}

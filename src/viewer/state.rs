@@ -1,0 +1,83 @@
+//! What the user edits in the viewer: the scene, its camera and the render
+//! settings. Plain data, no runtime handles: panels edit it directly, and
+//! any change to it restarts the passes.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use crate::camera::CameraSpec;
+use crate::scene::Scene;
+use crate::settings::RenderSettings;
+
+/// Where the current scene came from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SceneSource {
+    BuiltIn,
+    File(PathBuf),
+}
+
+impl SceneSource {
+    pub fn load(&self) -> anyhow::Result<Scene> {
+        Ok(match self {
+            SceneSource::BuiltIn => crate::scene::builtin::default_scene()?,
+            SceneSource::File(p) => crate::scene::load(p)?,
+        })
+    }
+
+    /// A short name for file names: the scene file's stem.
+    pub fn stem(&self) -> String {
+        match self {
+            SceneSource::BuiltIn => "default".into(),
+            SceneSource::File(p) => p
+                .file_stem()
+                .map_or("scene".into(), |s| s.to_string_lossy().into_owned()),
+        }
+    }
+
+    /// The scene's name as an exported PNG records it.
+    pub fn display_name(&self) -> String {
+        match self {
+            SceneSource::BuiltIn => crate::scene::builtin::NAME.to_string(),
+            SceneSource::File(p) => p.display().to_string(),
+        }
+    }
+}
+
+/// The scene, camera and settings the user edits.
+#[derive(Clone, Debug)]
+pub struct EditState {
+    pub source: SceneSource,
+    /// Shared with the render worker; edits copy lights and materials only
+    /// (the geometry sits behind its own `Arc`).
+    pub scene: Arc<Scene>,
+    /// Bumped whenever the scene changes, so the app can tell.
+    pub scene_version: u64,
+    pub camera: CameraSpec,
+    pub settings: RenderSettings,
+    /// The 16-sample pass after the 1-sample one.
+    pub anti_aliasing: bool,
+    /// Target time of a preview pass while the user drags (milliseconds).
+    pub frame_budget_ms: f64,
+}
+
+impl EditState {
+    /// Mutable access to lights and materials; marks the image stale.
+    pub fn scene_mut(&mut self) -> &mut Scene {
+        self.scene_version += 1;
+        Arc::make_mut(&mut self.scene)
+    }
+
+    /// The settings in one line, as the A/B comparison labels its images.
+    pub fn settings_label(&self) -> String {
+        let s = &self.settings;
+        format!(
+            "{}, AA {}, octree {}, depth {}, {}x{}",
+            s.view.name(),
+            if self.anti_aliasing { "on" } else { "off" },
+            if s.use_octree { "on" } else { "off" },
+            s.max_depth,
+            s.width,
+            s.height
+        )
+    }
+}
