@@ -473,6 +473,22 @@ fn round_step(x: f64) -> f64 {
         .unwrap_or(10.0 * power)
 }
 
+/// A session-time tick: blank left of 0 (the legend's room), with as many
+/// decimals as the step needs so that neighbouring ticks never read alike.
+fn time_tick_label(value: f64, step: f64) -> String {
+    if value < -0.5 * step {
+        return String::new();
+    }
+    let decimals = if step >= 1.0 {
+        0
+    } else {
+        (-step.log10()).ceil() as usize
+    };
+    // Grid values carry rounding error: the tick at 0 may be -1e-17.
+    let value = if value.abs() < 0.5 * step { 0.0 } else { value };
+    format!("{value:.decimals$}")
+}
+
 /// Every full pass of the session, one series per octree and anti-aliasing
 /// setting so each toggle shows as a jump between series, on a logarithmic
 /// time axis (a 100 s pass with the octree off must not flatten the rest).
@@ -534,9 +550,11 @@ fn pass_plot_ui(history: &[PassRecord], ui: &mut egui::Ui) {
         .include_x(-0.35 * newest)
         .include_x(newest * 1.05)
         .x_axis_label("session time (s)")
-        // Labelled ticks at a round step, about five across the axis.
+        // Labelled ticks at a round step, about three across the axis:
+        // egui_plot hides labels closer than 60 points, and the plot is
+        // about 250 points wide.
         .x_grid_spacer(egui_plot::uniform_grid_spacer(|input| {
-            let step = round_step((input.bounds.1 - input.bounds.0) / 5.0);
+            let step = round_step((input.bounds.1 - input.bounds.0) / 3.0);
             [step, step, step]
         }))
         .y_grid_spacer(egui_plot::uniform_grid_spacer(|_| [1.0, 1.0, 1.0]))
@@ -548,13 +566,7 @@ fn pass_plot_ui(history: &[PassRecord], ui: &mut egui::Ui) {
                 format!("{seconds:.0} s")
             }
         })
-        .x_axis_formatter(|mark, _| {
-            if mark.value < 0.0 {
-                String::new()
-            } else {
-                format!("{:.0}", mark.value)
-            }
-        })
+        .x_axis_formatter(|mark, _| time_tick_label(mark.value, mark.step_size))
         .show(ui, |plot| {
             for (octree, sixteen, name, color) in series {
                 let points: Vec<[f64; 2]> = full
@@ -614,4 +626,33 @@ pub fn status_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
             ui.label(RichText::new(&m.text).color(color));
         }
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_steps_are_one_two_or_five_times_a_power_of_ten() {
+        assert_eq!(round_step(0.28), 0.5);
+        assert_eq!(round_step(8.1), 10.0);
+        assert_eq!(round_step(13.0), 20.0);
+        assert_eq!(round_step(2.0), 2.0);
+        assert_eq!(round_step(0.0), 1.0);
+        assert_eq!(round_step(f64::NAN), 1.0);
+    }
+
+    #[test]
+    fn neighbouring_time_ticks_never_read_alike() {
+        // A session under a second: steps of 0.5 once printed "0 0 1".
+        let labels: Vec<_> = [-0.5, -1e-17, 0.5, 1.0]
+            .iter()
+            .map(|&v| time_tick_label(v, 0.5))
+            .collect();
+        assert_eq!(labels, ["", "0.0", "0.5", "1.0"]);
+        assert_eq!(time_tick_label(0.2, 0.1), "0.2");
+        assert_eq!(time_tick_label(0.05, 0.05), "0.05");
+        assert_eq!(time_tick_label(30.0, 10.0), "30");
+        assert_eq!(time_tick_label(-10.0, 10.0), "");
+    }
 }
