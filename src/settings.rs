@@ -4,7 +4,7 @@
 
 use crate::color::ColorConvention;
 use crate::scene::Scene;
-pub use crate::scene::Sides;
+pub use crate::scene::{AntiAliasing, Sides};
 
 /// What the image shows.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -123,45 +123,6 @@ impl std::str::FromStr for Protocol {
             .into_iter()
             .find(|p| p.name() == s)
             .ok_or_else(|| format!("unknown protocol `{s}` (expected glint or spd)"))
-    }
-}
-
-/// Anti-aliasing, as the command line, the viewer and scene files name it.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum AntiAliasing {
-    /// One ray through each pixel's centre.
-    #[default]
-    Off,
-    /// The centre everywhere, the 4x4 grid where neighbours differ.
-    Adaptive,
-    /// The regular 4x4 grid in every pixel.
-    Full,
-}
-
-impl AntiAliasing {
-    pub const ALL: [AntiAliasing; 3] = [
-        AntiAliasing::Off,
-        AntiAliasing::Adaptive,
-        AntiAliasing::Full,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            AntiAliasing::Off => "off",
-            AntiAliasing::Adaptive => "adaptive",
-            AntiAliasing::Full => "full",
-        }
-    }
-}
-
-impl std::str::FromStr for AntiAliasing {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Self::ALL
-            .into_iter()
-            .find(|a| a.name() == s)
-            .ok_or_else(|| format!("unknown anti-aliasing `{s}` (expected off, adaptive or full)"))
     }
 }
 

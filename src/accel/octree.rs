@@ -27,7 +27,7 @@
 
 use rayon::prelude::*;
 
-use super::{ClosestHit, Primitives, ShadowCrossings, test_closest, test_occlusion};
+use super::primitives::{ClosestHit, Primitives, ShadowCrossings, test_closest, test_occlusion};
 use crate::math::{Aabb, DVec3};
 use crate::shapes::{PreparedRay, Shape};
 use crate::stats::Counter;

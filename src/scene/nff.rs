@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use super::{ImageSettings, Location, Scene, SceneError};
+use super::model::{ImageSettings, Location, MAX_IMAGE_SIDE, Scene, SceneError};
 use crate::camera::CameraSpec;
 use crate::color::ColorConvention;
 use std::ops::RangeInclusive;
@@ -237,7 +237,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 tokens.label("hither")?;
                 let _hither = tokens.number("hither")?;
                 tokens.label("resolution")?;
-                let limit = super::MAX_IMAGE_SIDE as usize;
+                let limit = MAX_IMAGE_SIDE as usize;
                 let w = tokens.count("resolution", limit)?;
                 let h = tokens.count("resolution", limit)?;
                 if w == 0 || h == 0 {

@@ -8,7 +8,10 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::mesh::{MeshSource, Placement, parse_obj};
-use super::{ImageSettings, Location, MAX_IMAGE_SIDE, MAX_RAY_DEPTH, Scene, SceneError};
+use super::model::{
+    AntiAliasing, ImageSettings, Location, MAX_IMAGE_SIDE, MAX_RAY_DEPTH, Scene, SceneError,
+    line_column,
+};
 use crate::accel::OctreeParams;
 use crate::camera::CameraSpec;
 use crate::material::{
@@ -123,7 +126,7 @@ struct Context<'a> {
 
 impl Context<'_> {
     fn location(&self, span: Range<usize>, key: &str) -> Location {
-        let (line, column) = super::line_column(self.text, span.start);
+        let (line, column) = line_column(self.text, span.start);
         Location {
             path: self.path.to_owned(),
             line,
@@ -278,14 +281,14 @@ pub fn parse(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, S
         if im.samples.is_some() {
             return Err(cx.error(v.span(), "image.aa", "give `samples` or `aa`, not both"));
         }
-        let aa: crate::settings::AntiAliasing = v
+        let aa: AntiAliasing = v
             .get_ref()
             .parse()
             .map_err(|e: String| cx.error(v.span(), "image.aa", e))?;
         (image.samples, image.adaptive) = match aa {
-            crate::settings::AntiAliasing::Off => (1, false),
-            crate::settings::AntiAliasing::Adaptive => (16, true),
-            crate::settings::AntiAliasing::Full => (16, false),
+            AntiAliasing::Off => (1, false),
+            AntiAliasing::Adaptive => (16, true),
+            AntiAliasing::Full => (16, false),
         };
     }
     if let Some(v) = &im.sides {

@@ -1,4 +1,4 @@
-use super::{Crossings, ShapeHit, Surface};
+use super::hit::{Crossings, ShapeHit, Surface, unit_or_none};
 use crate::math::{Aabb, DVec3, Ray, solve_quadratic_half};
 
 /// Open truncated cone (or cylinder) between two disks, without end caps:
@@ -103,12 +103,12 @@ impl Cone {
         let z = q.dot(self.axis);
         let q_perp = q - z * self.axis;
         let r = self.base_radius + self.slope * z;
-        let radial = super::unit_or_none(q_perp);
+        let radial = unit_or_none(q_perp);
         // Re-project onto the surface radially, then take the gradient
         // `q_perp - r s axis` (up to a factor), which vanishes only at an apex.
         let point = radial.map_or(p, |u| self.base + z * self.axis + r.max(0.0) * u);
         let normal = radial
-            .and_then(|u| super::unit_or_none(u - self.slope * self.axis))
+            .and_then(|u| unit_or_none(u - self.slope * self.axis))
             .unwrap_or(-ray.dir);
         Surface {
             point,

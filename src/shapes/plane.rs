@@ -1,4 +1,4 @@
-use super::ShapeHit;
+use super::hit::{ShapeHit, Surface};
 use crate::math::{DVec3, Ray};
 
 /// Infinite plane through `point` with unit `normal`.
@@ -27,11 +27,11 @@ impl Plane {
         (t > 0.0 && t < t_max).then_some(ShapeHit::at(t))
     }
 
-    pub fn surface(&self, ray: &Ray, hit: &ShapeHit) -> super::Surface {
+    pub fn surface(&self, ray: &Ray, hit: &ShapeHit) -> Surface {
         let p = ray.at(hit.t);
         // Project onto the plane to remove the error of travelling along the ray.
         let point = p - (p - self.point).dot(self.normal) * self.normal;
-        super::Surface {
+        Surface {
             point,
             geometric_normal: self.normal,
             shading_normal: self.normal,

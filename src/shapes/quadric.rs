@@ -1,4 +1,4 @@
-use super::{Crossings, ShapeHit, Surface};
+use super::hit::{Crossings, ShapeHit, Surface, unit_or_none};
 use crate::math::{Aabb, DVec3, Ray, solve_quadratic_half};
 
 /// General quadric surface
@@ -147,7 +147,7 @@ impl Quadric {
         }
         // The gradient vanishes at a cone's apex: any normal is as good as
         // another there, so face the ray.
-        let normal = super::unit_or_none(self.gradient(point)).unwrap_or(-ray.dir);
+        let normal = unit_or_none(self.gradient(point)).unwrap_or(-ray.dir);
         Surface {
             point,
             geometric_normal: normal,

@@ -1,4 +1,4 @@
-use super::{Crossings, ShapeHit};
+use super::hit::{Crossings, ShapeHit, Surface, unit_or_none};
 use crate::math::{Aabb, DVec3, Ray};
 
 #[derive(Clone, Debug, PartialEq)]
@@ -61,14 +61,14 @@ impl Sphere {
         out
     }
 
-    pub fn surface(&self, ray: &Ray, hit: &ShapeHit) -> super::Surface {
+    pub fn surface(&self, ray: &Ray, hit: &ShapeHit) -> Surface {
         let p = ray.at(hit.t);
         let radial = p - self.center;
         // Re-project onto the sphere: the point's error then depends on the
         // sphere's own magnitude, not on how far the ray travelled.
-        let normal = super::unit_or_none(radial).unwrap_or(-ray.dir);
+        let normal = unit_or_none(radial).unwrap_or(-ray.dir);
         let point = self.center + normal * self.radius;
-        super::Surface {
+        Surface {
             point,
             geometric_normal: normal,
             shading_normal: normal,

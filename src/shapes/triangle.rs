@@ -1,4 +1,4 @@
-use super::{PreparedRay, ShapeHit, Surface};
+use super::hit::{PreparedRay, ShapeHit, Surface, unit_or_none};
 use crate::math::{Aabb, DVec3};
 
 /// Marker for "no vertex normals": the triangle is flat shaded.
@@ -83,7 +83,7 @@ impl Triangle {
         let normal = self.normal();
         let shading_normal = vertex_normals
             .get(self.vertex_normals as usize)
-            .and_then(|[n0, n1, n2]| super::unit_or_none(b0 * *n0 + hit.b1 * *n1 + hit.b2 * *n2))
+            .and_then(|[n0, n1, n2]| unit_or_none(b0 * *n0 + hit.b1 * *n1 + hit.b2 * *n2))
             .unwrap_or(normal);
         Surface {
             point,
