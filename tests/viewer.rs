@@ -17,13 +17,18 @@ use glint::viewer::{GlintApp, SceneSource, ViewerOptions};
 
 const WAIT: Duration = Duration::from_secs(60);
 
+/// The viewer on a scene of the repository, rendering at `width` x `height`.
+fn app_for(scene: &str, width: u32, height: u32) -> GlintApp {
+    let source = SceneSource::File(common::repo_path(scene));
+    let mut app = GlintApp::new(source, ViewerOptions::default(), || {}).unwrap();
+    app.settings_mut().width = width;
+    app.settings_mut().height = height;
+    app
+}
+
 /// A small, quick scene for UI tests.
 fn small_app() -> GlintApp {
-    let source = SceneSource::File(common::repo_path("scenes/sphere.toml"));
-    let mut app = GlintApp::new(source, ViewerOptions::default(), || {}).unwrap();
-    app.settings_mut().width = 64;
-    app.settings_mut().height = 48;
-    app
+    app_for("scenes/sphere.toml", 64, 48)
 }
 
 fn harness(app: GlintApp) -> Harness<'static, GlintApp> {
@@ -394,10 +399,7 @@ fn viewer_exports_render_again_identically_from_their_metadata() {
 
 #[test]
 fn protocol_spd_in_the_viewer_is_one_corner_pass_equal_to_the_cli() {
-    let source = SceneSource::File(common::repo_path("scenes/spd/sizes/balls_s1.nff"));
-    let mut app = GlintApp::new(source, ViewerOptions::default(), || {}).unwrap();
-    app.settings_mut().width = 48;
-    app.settings_mut().height = 40;
+    let mut app = app_for("scenes/spd/sizes/balls_s1.nff", 48, 40);
     app.set_anti_aliasing(true);
     let mut h = harness(app);
     // NFF scenes shade display values by default; the panel says so.
@@ -511,11 +513,7 @@ fn a_budget_preview_drops_what_it_says() {
 fn a_deep_ray_tree_leaves_the_panels_and_the_image_apart() {
     // The glass pixel's tree nests four levels of headers, which do not
     // wrap; once they widened the timing panel and the image slid under it.
-    let source = SceneSource::File(common::repo_path("scenes/glass.toml"));
-    let mut app = GlintApp::new(source, ViewerOptions::default(), || {}).unwrap();
-    app.settings_mut().width = 480;
-    app.settings_mut().height = 360;
-    let mut h = harness(app);
+    let mut h = harness(app_for("scenes/glass.toml", 480, 360));
     let before = h.state().image_rect().unwrap();
     h.state_mut().inspect_pixel(250, 200);
     h.run_steps(4);

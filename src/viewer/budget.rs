@@ -192,19 +192,7 @@ mod tests {
 
     #[test]
     fn preview_estimates_scale_with_pixels_and_rays_cast() {
-        let settings = RenderSettings {
-            width: 800,
-            height: 600,
-            samples: 1,
-            max_depth: 5,
-            use_octree: true,
-            view: crate::settings::ViewMode::Shaded,
-            protocol: crate::settings::Protocol::Glint,
-            colors: crate::color::ColorConvention::Linear,
-            sides: crate::settings::Sides::Two,
-            adaptive: false,
-            shadows: true,
-        };
+        let settings = settings();
         let p = |divisor, reflections, shadows| Preview {
             divisor,
             reflections,
