@@ -7,7 +7,7 @@ pub const NO_NORMALS: u32 = u32::MAX;
 #[derive(Clone, Debug, PartialEq)]
 pub struct Triangle {
     pub vertices: [DVec3; 3],
-    /// Index into the scene's per-triangle vertex normals, or [`NO_NORMALS`].
+    /// Index into the scene's per-triangle vertex normals, or `NO_NORMALS` (`u32::MAX`).
     pub vertex_normals: u32,
 }
 

@@ -242,7 +242,10 @@ impl GlintApp {
             .pin_as_a(&self.worker, self.edit.settings_label());
     }
 
-    /// Saves the frame on screen; see [`export::export_to`].
+    /// Saves the frame on screen with the record of how it was made (see
+    /// [`crate::export`]): the scene, camera and settings of the pass on
+    /// screen, not the panels' current values; a pass still sweeping in is
+    /// written as displayed and recorded as partial.
     pub fn export_to(&self, path: &Path) -> anyhow::Result<()> {
         export::export_to(
             path,
