@@ -12,7 +12,7 @@ use egui_kittest::kittest::Queryable;
 use glint::accel::Octree;
 use glint::render::Renderer;
 use glint::settings::RenderSettings;
-use glint::viewer::worker::{Job, PassKind, Worker};
+use glint::viewer::worker::{Job, PassKind, Worker, rgba_to_rgb};
 use glint::viewer::{GlintApp, SceneSource, ViewerOptions};
 
 const WAIT: Duration = Duration::from_secs(60);
@@ -109,10 +109,7 @@ fn export_writes_the_displayed_buffer() {
         .worker()
         .with_buffer(|b| (b.width, b.height, b.rgba.clone()));
     assert_eq!((png.width(), png.height()), (w, hgt));
-    let rgb: Vec<u8> = rgba
-        .chunks_exact(4)
-        .flat_map(|p| [p[0], p[1], p[2]])
-        .collect();
+    let rgb = rgba_to_rgb(&rgba);
     assert!(
         png.into_raw() == rgb,
         "exported pixels equal the display buffer"
@@ -168,12 +165,7 @@ fn passes_run_one_then_sixteen_and_the_final_buffer_equals_the_cli_render() {
     .render(false, None)
     .0
     .to_rgb8();
-    let shown: Vec<u8> = worker.with_buffer(|b| {
-        b.rgba
-            .chunks_exact(4)
-            .flat_map(|p| [p[0], p[1], p[2]])
-            .collect()
-    });
+    let shown: Vec<u8> = worker.with_buffer(|b| rgba_to_rgb(&b.rgba));
     assert!(
         shown == cli,
         "the finished 16-sample buffer is byte-identical to the CLI render"
@@ -439,12 +431,7 @@ fn protocol_spd_in_the_viewer_is_one_corner_pass_equal_to_the_cli() {
         .render(false, None)
         .0
         .to_rgb8();
-    let shown: Vec<u8> = h.state().worker().with_buffer(|b| {
-        b.rgba
-            .chunks_exact(4)
-            .flat_map(|p| [p[0], p[1], p[2]])
-            .collect()
-    });
+    let shown: Vec<u8> = h.state().worker().with_buffer(|b| rgba_to_rgb(&b.rgba));
     assert!(
         shown == cli,
         "the corner pass equals `glint render --protocol spd`"
@@ -469,12 +456,7 @@ fn adaptive_refinement_pass_equals_the_cli_adaptive_render() {
         .unwrap()
         .render(false, None);
     assert_eq!(counts.refined_pixels, refined);
-    let shown: Vec<u8> = worker.with_buffer(|b| {
-        b.rgba
-            .chunks_exact(4)
-            .flat_map(|p| [p[0], p[1], p[2]])
-            .collect()
-    });
+    let shown: Vec<u8> = worker.with_buffer(|b| rgba_to_rgb(&b.rgba));
     assert!(
         shown == frame.to_rgb8(),
         "the viewer's adaptive pass equals `glint render --aa adaptive`"

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use super::state::SceneSource;
-use super::worker::Worker;
+use super::worker::{Worker, rgba_to_rgb};
 use crate::accel::Octree;
 use crate::export::{RenderRecord, SceneEdits};
 
@@ -75,10 +75,7 @@ pub fn export_to(
         },
         _ => {
             record.settings.partial = true;
-            let rgb: Vec<u8> = rgba
-                .chunks_exact(4)
-                .flat_map(|p| [p[0], p[1], p[2]])
-                .collect();
+            let rgb = rgba_to_rgb(&rgba);
             crate::export::save_rgb_png(path, w, h, &rgb, Some(&record))?
         }
     }

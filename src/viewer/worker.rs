@@ -671,6 +671,13 @@ pub fn rgb_to_rgba(rgb: &[u8]) -> Vec<u8> {
     out
 }
 
+/// The display buffer's pixels without alpha, as a PNG stores them.
+pub fn rgba_to_rgb(rgba: &[u8]) -> Vec<u8> {
+    rgba.chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
