@@ -79,8 +79,10 @@ impl CameraSpec {
 
 impl Camera {
     pub fn new(spec: &CameraSpec, width: u32, height: u32) -> Result<Self, CameraError> {
-        if !(spec.eye.is_finite() && spec.lookat.is_finite() && spec.up.is_finite())
-            || !spec.fov.is_finite()
+        if !(spec.eye.is_finite()
+            && spec.lookat.is_finite()
+            && spec.up.is_finite()
+            && spec.fov.is_finite())
         {
             return Err(CameraError::NotFinite);
         }

@@ -73,8 +73,7 @@ pub fn nearest_depth(pixels: &[DVec3]) -> f64 {
         .filter(|p| p.y > 0.0)
         .map(|p| p.x)
         .fold(f64::INFINITY, f64::min)
-        .min(f64::MAX)
-        .max(0.0)
+        .clamp(0.0, f64::MAX)
 }
 
 /// Grey level of a depth-view pixel: `near / distance`, so the nearest

@@ -12,6 +12,9 @@
 //! ```
 
 #![forbid(unsafe_code)]
+// NaN guards are written `!(x > 0.0)` on purpose: the negated comparison is
+// true for NaN, which `x <= 0.0` is not.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod accel;
 pub mod adaptive;

@@ -386,7 +386,8 @@ fn records_outside_the_limits_are_refused() {
     let path = dir.join("bad.png");
     let base =
         glint::export::RenderRecord::new(&scene, "scenes/sphere.toml", &scene.camera, settings);
-    let cases: [(&str, Box<dyn Fn(&mut glint::export::RenderRecord)>); 4] = [
+    type Spoil = Box<dyn Fn(&mut glint::export::RenderRecord)>;
+    let cases: [(&str, Spoil); 4] = [
         (
             "leaf_size",
             Box::new(|r| r.settings.octree_params.leaf_size = 0),

@@ -516,8 +516,8 @@ impl Octree {
             // the ray passes through follow by flipping one bit at each.
             let mut inside = [0usize; 3];
             let mut n_inside = 0;
-            for k in 0..3 {
-                if t_mid[k] > e.t0 && t_mid[k] < e.t1 {
+            for (k, &t) in t_mid.iter().enumerate() {
+                if t > e.t0 && t < e.t1 {
                     inside[n_inside] = k;
                     n_inside += 1;
                 }

@@ -61,7 +61,6 @@ pub fn parse_obj(
         single_index: true,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     };
     let mut reader = std::io::BufReader::new(bytes);
     let (models, _) = tobj::load_obj_buf(&mut reader, &options, |_| Ok(Default::default()))

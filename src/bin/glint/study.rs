@@ -167,23 +167,23 @@ pub fn run(args: &StudyArgs) -> Result<()> {
             )?;
             if samples == 1 {
                 one = Some(f);
-            } else if samples == 16 {
-                if let Some(one) = &one {
-                    let need = args.out.join(format!("{stem}-aa-need.png"));
-                    // The same picture as `glint render --view aa-need`, legend included.
-                    glint::export::save_png(&Frame::aa_need(one, &f), &need, None)?;
-                    let e = image_error(&one.pixels, &f.pixels, base.colors);
-                    summary.push((
-                        stem.clone(),
-                        "1 vs 16 samples: pixels anti-aliasing changes".to_string(),
-                        format!("{:.1}%", 100.0 * e.visible_fraction),
-                    ));
-                    summary.push((
-                        stem.clone(),
-                        "16 / 1 sample time".into(),
-                        format!("{:.1}x", t / t_one),
-                    ));
-                }
+            } else if samples == 16
+                && let Some(one) = &one
+            {
+                let need = args.out.join(format!("{stem}-aa-need.png"));
+                // The same picture as `glint render --view aa-need`, legend included.
+                glint::export::save_png(&Frame::aa_need(one, &f), &need, None)?;
+                let e = image_error(&one.pixels, &f.pixels, base.colors);
+                summary.push((
+                    stem.clone(),
+                    "1 vs 16 samples: pixels anti-aliasing changes".to_string(),
+                    format!("{:.1}%", 100.0 * e.visible_fraction),
+                ));
+                summary.push((
+                    stem.clone(),
+                    "16 / 1 sample time".into(),
+                    format!("{:.1}x", t / t_one),
+                ));
             }
         }
         writeln!(
