@@ -3,6 +3,8 @@
 //! aa-need difference. Writing files is [`crate::export`]'s (which uses
 //! frames; frames never use it).
 
+use std::sync::Mutex;
+
 use rayon::prelude::*;
 
 use crate::color::{ColorConvention, to_byte};
@@ -121,6 +123,86 @@ fn format_count(v: f64) -> String {
     } else {
         format!("{v:.1}")
     }
+}
+
+/// Encodes the tiles of a pass for display before the pass is complete:
+/// depth is normalised by the nearest distance seen so far, cost by the
+/// range seen so far (the finished pass's frame replaces them with the
+/// exact picture); the other views encode exactly as [`Frame::to_rgb8`].
+pub struct TileEncoder {
+    view: ViewMode,
+    colors: ColorConvention,
+    /// Nearest and farthest value seen so far (depth: distances; cost: counts).
+    range: Mutex<(f64, f64)>,
+}
+
+impl TileEncoder {
+    pub fn new(view: ViewMode, colors: ColorConvention) -> Self {
+        Self {
+            view,
+            colors,
+            range: Mutex::new((f64::INFINITY, f64::NEG_INFINITY)),
+        }
+    }
+
+    /// RGB8 of a tile's values, row-major.
+    pub fn rgb(&self, values: &[DVec3]) -> Vec<u8> {
+        let view = self.view;
+        match view {
+            ViewMode::Cost | ViewMode::CostSteps => {
+                let range = {
+                    let mut r = self.range.lock().unwrap_or_else(|e| e.into_inner());
+                    for v in values {
+                        let c = cost_value(*v, view);
+                        r.0 = r.0.min(c);
+                        r.1 = r.1.max(c);
+                    }
+                    *r
+                };
+                values
+                    .iter()
+                    .flat_map(|v| crate::legend::viridis(cost_shade(cost_value(*v, view), range)))
+                    .collect()
+            }
+            ViewMode::Depth => {
+                let near = {
+                    let mut r = self.range.lock().unwrap_or_else(|e| e.into_inner());
+                    if values.iter().any(|v| v.y > 0.0) {
+                        r.0 = r.0.min(nearest_depth(values));
+                    }
+                    r.0
+                };
+                values
+                    .iter()
+                    .flat_map(|v| [to_byte(depth_shade(*v, near)); 3])
+                    .collect()
+            }
+            _ => Frame {
+                width: values.len() as u32,
+                height: 1,
+                view,
+                colors: self.colors,
+                pixels: values.to_vec(),
+            }
+            .to_rgb8(),
+        }
+    }
+}
+
+/// RGB8 to opaque RGBA8.
+pub fn rgb_to_rgba(rgb: &[u8]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(rgb.len() / 3 * 4);
+    for p in rgb.chunks_exact(3) {
+        out.extend_from_slice(&[p[0], p[1], p[2], 255]);
+    }
+    out
+}
+
+/// RGBA8 without its alpha, as a PNG of glint's stores it.
+pub fn rgba_to_rgb(rgba: &[u8]) -> Vec<u8> {
+    rgba.chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect()
 }
 
 impl Frame {
@@ -243,5 +325,49 @@ impl Frame {
             None => self.height,
         };
         (rgb, height)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_tile_of_the_shaded_view_encodes_like_the_whole_frame() {
+        let values = [
+            DVec3::new(0.0, 0.5, 1.0),
+            DVec3::new(2.0, -1.0, 0.25),
+            DVec3::splat(0.0031308),
+        ];
+        let encoder = TileEncoder::new(ViewMode::Shaded, ColorConvention::Linear);
+        let tile = rgb_to_rgba(&encoder.rgb(&values));
+        // sRGB encoding (IEC 61966-2-1) of each channel, clamped to [0, 1].
+        let srgb = |x: f64| {
+            let x = x.clamp(0.0, 1.0);
+            let e = if x <= 0.0031308 {
+                12.92 * x
+            } else {
+                1.055 * x.powf(1.0 / 2.4) - 0.055
+            };
+            (e * 255.0).round() as u8
+        };
+        let expected: Vec<u8> = values
+            .iter()
+            .flat_map(|v| [srgb(v.x), srgb(v.y), srgb(v.z), 255])
+            .collect();
+        assert_eq!(tile, expected);
+        assert_eq!(rgba_to_rgb(&tile), encoder.rgb(&values));
+    }
+
+    #[test]
+    fn depth_tiles_are_normalised_by_the_nearest_distance_seen_so_far() {
+        let encoder = TileEncoder::new(ViewMode::Depth, ColorConvention::Linear);
+        // Distance 4, then a tile whose nearest point is at 2.
+        let far = [DVec3::new(4.0, 1.0, 0.0), DVec3::ZERO];
+        assert_eq!(encoder.rgb(&far), [255, 255, 255, 0, 0, 0]);
+        let near = [DVec3::new(2.0, 1.0, 0.0)];
+        assert_eq!(encoder.rgb(&near), [255, 255, 255]);
+        // The first tile again: now half as bright.
+        assert_eq!(encoder.rgb(&far)[0], 128);
     }
 }

@@ -4,7 +4,7 @@
 //! ```no_run
 //! let scene = glint::scene::load(std::path::Path::new("scenes/spheres.toml"))?;
 //! let octree = glint::accel::Octree::build(&scene.shapes, scene.octree_params)?;
-//! let settings = glint::settings::RenderSettings::from_scene(&scene);
+//! let settings = scene.render_settings();
 //! let renderer = glint::render::Renderer::new(&scene, &octree, settings)?;
 //! let (frame, _counts) = renderer.render(false, None);
 //! glint::export::save_png(&frame, std::path::Path::new("spheres.png"), None)?;
@@ -17,23 +17,22 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod accel;
-pub mod adaptive;
 pub mod camera;
 pub mod color;
 pub mod export;
 pub mod frame;
 pub mod legend;
+pub mod limits;
 pub mod material;
 pub mod math;
-pub mod memory;
 pub mod metrics;
 pub mod overlay;
+pub mod published;
 pub mod ray_tree;
 pub mod render;
 pub mod scene;
 pub mod settings;
 pub mod shapes;
 pub mod stats;
-pub mod tiles;
 #[cfg(feature = "gui")]
 pub mod viewer;

@@ -1,62 +1,9 @@
 //! Whitted/Phong materials and point lights, colours in linear RGB.
 
-use std::ops::RangeInclusive;
-
+use crate::limits::{
+    INTENSITY_RANGE, IOR_RANGE, SHININESS_RANGE, UNIT_RANGE, check_color, check_range,
+};
 use crate::math::{Color, DVec3};
-
-/// Surface colours and the weights `kd`, `ks`, `reflectivity` and
-/// `transparency`: a surface sends on at most what it receives.
-pub const UNIT_RANGE: RangeInclusive<f64> = 0.0..=1.0;
-/// Light colours, the ambient light and the background: intensities, which
-/// may exceed 1 (the picture then clips).
-pub const INTENSITY_RANGE: RangeInclusive<f64> = 0.0..=1000.0;
-/// The Phong exponent (the SPD's scenes use 100,000 for "no highlight").
-pub const SHININESS_RANGE: RangeInclusive<f64> = 0.0..=1.0e6;
-/// Index of refraction of a surface's inside (below 1: a bubble).
-pub const IOR_RANGE: RangeInclusive<f64> = 0.01..=100.0;
-
-// Within these ranges no pixel can overflow: a hit adds at most
-// 1000 (ambient) + 2000 per light, and each of at most 64 recursion levels
-// at most doubles it (reflectivity + transparency <= 2).
-
-/// A number as people write it: `1e300` rather than its 301 digits.
-pub fn format_number(x: f64) -> String {
-    if x != 0.0 && x.is_finite() && !(1e-4..1e7).contains(&x.abs()) {
-        format!("{x:e}")
-    } else {
-        format!("{x}")
-    }
-}
-
-/// Why a value is out of its range, e.g. "must lie in [0, 1], got 2".
-pub fn check_range(x: f64, range: &RangeInclusive<f64>) -> Result<f64, String> {
-    if range.contains(&x) {
-        Ok(x)
-    } else {
-        Err(format!(
-            "must lie in [{}, {}], got {}",
-            range.start(),
-            range.end(),
-            format_number(x)
-        ))
-    }
-}
-
-/// Like [`check_range`] for each component of a colour.
-pub fn check_color(c: DVec3, range: &RangeInclusive<f64>) -> Result<DVec3, String> {
-    if c.to_array().iter().all(|x| range.contains(x)) {
-        Ok(c)
-    } else {
-        Err(format!(
-            "each component must lie in [{}, {}], got [{}, {}, {}]",
-            range.start(),
-            range.end(),
-            format_number(c.x),
-            format_number(c.y),
-            format_number(c.z)
-        ))
-    }
-}
 
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Material {

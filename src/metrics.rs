@@ -8,7 +8,7 @@ use crate::math::DVec3;
 /// shading values (linear light, or display values under
 /// [`ColorConvention::Display`]) and as displayed (after the convention's
 /// encoding: sRGB for linear frames), both on [0, 1] with channels clamped.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ImageError {
     pub rmse_shaded: f64,
     pub psnr_shaded: f64,

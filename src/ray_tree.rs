@@ -7,6 +7,7 @@
 use serde::Serialize;
 
 use crate::math::{Color, Ray};
+use crate::shapes::ShapeKind;
 
 /// Why a ray was cast.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -23,7 +24,7 @@ pub struct HitRecord {
     /// Index of the shape in the scene's shape list.
     pub object: u32,
     /// Kind of the shape: sphere, plane, triangle, quadric, cone.
-    pub kind: &'static str,
+    pub kind: ShapeKind,
     pub material: String,
     pub distance: f64,
     pub point: [f64; 3],
@@ -33,13 +34,37 @@ pub struct HitRecord {
     pub entering: bool,
 }
 
+/// What a light does at a hit point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ShadowVerdict {
+    /// The shadow ray reaches the light unhindered.
+    Lit,
+    /// An opaque surface blocks it.
+    Blocked,
+    /// It passes through transparent surfaces, which dim the light.
+    Attenuated,
+    /// The surface faces away from the light: no shadow ray is cast.
+    FacesAway,
+}
+
+impl ShadowVerdict {
+    /// As the JSON spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            ShadowVerdict::Lit => "lit",
+            ShadowVerdict::Blocked => "blocked",
+            ShadowVerdict::Attenuated => "attenuated",
+            ShadowVerdict::FacesAway => "faces-away",
+        }
+    }
+}
+
 /// One light's verdict at a hit point.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ShadowRecord {
     pub light: usize,
-    /// `lit`, `blocked`, `attenuated` (behind transparent shapes) or
-    /// `faces-away` (the surface faces away: no shadow ray is cast).
-    pub verdict: &'static str,
+    pub verdict: ShadowVerdict,
     /// Fraction of the light arriving: 1 lit, 0 blocked or faces-away.
     pub transmittance: f64,
     /// Diffuse and specular light this light adds (linear RGB).

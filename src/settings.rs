@@ -2,9 +2,9 @@
 //! many rays, by which rules. Scene files set defaults; the command line
 //! and the viewer override them.
 
+use crate::accel::OctreeParams;
 use crate::color::ColorConvention;
-use crate::scene::Scene;
-pub use crate::scene::{AntiAliasing, Sides};
+use crate::limits::LimitError;
 
 /// What the image shows.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -161,20 +161,11 @@ fn yes() -> bool {
 }
 
 impl RenderSettings {
-    pub fn from_scene(scene: &Scene) -> Self {
-        Self {
-            width: scene.image.width,
-            height: scene.image.height,
-            samples: scene.image.samples,
-            max_depth: scene.image.max_depth,
-            use_octree: scene.octree_enabled,
-            view: ViewMode::Shaded,
-            protocol: Protocol::Glint,
-            colors: scene.image.colors,
-            sides: scene.image.sides,
-            adaptive: scene.image.adaptive,
-            shadows: true,
-        }
+    /// Every value within [`crate::limits`].
+    pub fn check(&self) -> Result<(), LimitError> {
+        crate::limits::check_image_size(self.width, self.height)?;
+        crate::limits::check_samples(self.samples)?;
+        crate::limits::check_max_depth(self.max_depth)
     }
 
     /// The anti-aliasing these settings ask for.
@@ -206,8 +197,262 @@ impl RenderSettings {
         }
     }
 
+    /// Switches to `protocol` as the viewer does: entering the SPD protocol
+    /// takes its depth and sidedness; leaving it restores the scene's own
+    /// (`scene`, the scene's settings), which the protocol had replaced.
+    pub fn switch_protocol(self, protocol: Protocol, scene: &RenderSettings) -> Self {
+        if protocol == self.protocol {
+            return self;
+        }
+        match protocol {
+            Protocol::Glint => Self {
+                protocol,
+                max_depth: scene.max_depth,
+                sides: scene.sides,
+                ..self
+            },
+            Protocol::Spd => self.with_protocol(protocol),
+        }
+    }
+
     /// Whether eye rays go through pixel corners (the SPD protocol).
     pub fn corner_rays(&self) -> bool {
         self.protocol == Protocol::Spd
+    }
+}
+
+/// Which sides of a surface rays can hit.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Sides {
+    /// Every surface is seen from both sides (glint's default).
+    #[default]
+    Two,
+    /// Opaque surfaces are seen from outside only, as the SPD allows (a
+    /// ray meeting one from behind passes on). Transparent surfaces, and
+    /// triangles with vertex normals (NFF `pp` patches, smooth meshes:
+    /// tessellated open surfaces such as the SPD's teapot, which the SPD
+    /// requires two-sided) stay two-sided.
+    One,
+}
+
+impl Sides {
+    pub const ALL: [Sides; 2] = [Sides::Two, Sides::One];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Sides::Two => "two",
+            Sides::One => "one",
+        }
+    }
+}
+
+impl std::str::FromStr for Sides {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|p| p.name() == s)
+            .ok_or_else(|| format!("unknown sidedness `{s}` (expected one or two)"))
+    }
+}
+
+/// Anti-aliasing, as the command line, the viewer and scene files name it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum AntiAliasing {
+    /// One ray through each pixel's centre.
+    #[default]
+    Off,
+    /// The centre everywhere, the 4x4 grid where neighbours differ.
+    Adaptive,
+    /// The regular 4x4 grid in every pixel.
+    Full,
+}
+
+impl AntiAliasing {
+    pub const ALL: [AntiAliasing; 3] = [
+        AntiAliasing::Off,
+        AntiAliasing::Adaptive,
+        AntiAliasing::Full,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            AntiAliasing::Off => "off",
+            AntiAliasing::Adaptive => "adaptive",
+            AntiAliasing::Full => "full",
+        }
+    }
+}
+
+impl std::str::FromStr for AntiAliasing {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|a| a.name() == s)
+            .ok_or_else(|| format!("unknown anti-aliasing `{s}` (expected off, adaptive or full)"))
+    }
+}
+
+/// What the command line or the viewer asks for instead of a scene's own
+/// settings; `None` keeps the scene's. `glint render`, `bench`, `view` and
+/// the viewer all apply them through [`Overrides::apply`], in one order.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Overrides {
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+    pub anti_aliasing: Option<AntiAliasing>,
+    pub max_depth: Option<u32>,
+    pub use_octree: Option<bool>,
+    pub octree: OctreeOverrides,
+    pub view: Option<ViewMode>,
+    /// Applied before colours and sides: it sets its own depth and sidedness.
+    pub protocol: Option<Protocol>,
+    pub colors: Option<ColorConvention>,
+    pub sides: Option<Sides>,
+}
+
+/// Octree parameters overriding a scene's; `None` keeps the scene's.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OctreeOverrides {
+    pub max_depth: Option<u32>,
+    pub leaf_size: Option<u32>,
+    pub cost_driven: Option<bool>,
+    pub max_duplication: Option<u32>,
+    pub memory_budget_mib: Option<u32>,
+}
+
+impl OctreeOverrides {
+    pub fn apply(&self, params: &mut OctreeParams) {
+        if let Some(d) = self.max_depth {
+            params.max_depth = d.min(crate::limits::MAX_OCTREE_DEPTH);
+        }
+        if let Some(n) = self.leaf_size {
+            params.leaf_size = n;
+        }
+        if let Some(c) = self.cost_driven {
+            params.cost_driven = c;
+        }
+        if let Some(d) = self.max_duplication {
+            params.max_duplication = d;
+        }
+        if let Some(m) = self.memory_budget_mib {
+            params.memory_budget_mib = m;
+        }
+    }
+}
+
+impl Overrides {
+    /// Applies the overrides to `settings` and the octree's `params`: size,
+    /// anti-aliasing, depth, the octree switch and parameters, the view,
+    /// then the protocol (which sets its depth and sidedness) and last the
+    /// explicit colour and sidedness choices.
+    pub fn apply(&self, settings: &mut RenderSettings, params: &mut OctreeParams) {
+        if let Some(w) = self.width {
+            settings.width = w;
+        }
+        if let Some(h) = self.height {
+            settings.height = h;
+        }
+        if let Some(aa) = self.anti_aliasing {
+            settings.set_anti_aliasing(aa);
+        }
+        if let Some(d) = self.max_depth {
+            settings.max_depth = d;
+        }
+        if let Some(o) = self.use_octree {
+            settings.use_octree = o;
+        }
+        self.octree.apply(params);
+        if let Some(v) = self.view {
+            settings.view = v;
+        }
+        if let Some(p) = self.protocol {
+            *settings = settings.with_protocol(p);
+        }
+        if let Some(c) = self.colors {
+            settings.colors = c;
+        }
+        if let Some(s) = self.sides {
+            settings.sides = s;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn base() -> RenderSettings {
+        RenderSettings {
+            width: 64,
+            height: 48,
+            samples: 1,
+            max_depth: 7,
+            use_octree: true,
+            view: ViewMode::Shaded,
+            protocol: Protocol::Glint,
+            colors: ColorConvention::Linear,
+            sides: Sides::Two,
+            adaptive: false,
+            shadows: true,
+        }
+    }
+
+    #[test]
+    fn the_protocol_applies_after_depth_and_before_explicit_sides() {
+        let mut settings = base();
+        let mut params = OctreeParams::default();
+        Overrides {
+            max_depth: Some(3),
+            protocol: Some(Protocol::Spd),
+            sides: Some(Sides::Two),
+            anti_aliasing: Some(AntiAliasing::Adaptive),
+            octree: OctreeOverrides {
+                leaf_size: Some(9),
+                max_depth: Some(1000),
+                ..OctreeOverrides::default()
+            },
+            ..Overrides::default()
+        }
+        .apply(&mut settings, &mut params);
+        assert_eq!(settings.max_depth, 5, "the SPD protocol fixes depth 5");
+        assert_eq!(settings.sides, Sides::Two, "an explicit choice wins");
+        assert_eq!((settings.samples, settings.adaptive), (16, true));
+        assert_eq!(params.leaf_size, 9);
+        assert_eq!(params.max_depth, crate::limits::MAX_OCTREE_DEPTH);
+    }
+
+    #[test]
+    fn leaving_the_spd_protocol_restores_the_scenes_depth_and_sides() {
+        let scene = base();
+        let spd = scene.switch_protocol(Protocol::Spd, &scene);
+        assert_eq!((spd.max_depth, spd.sides), (5, Sides::One));
+        let back = spd.switch_protocol(Protocol::Glint, &scene);
+        assert_eq!(back, scene);
+    }
+
+    #[test]
+    fn settings_outside_the_limits_are_refused() {
+        assert!(base().check().is_ok());
+        for bad in [
+            RenderSettings {
+                samples: 8,
+                ..base()
+            },
+            RenderSettings {
+                max_depth: 0,
+                ..base()
+            },
+            RenderSettings {
+                max_depth: 65,
+                ..base()
+            },
+            RenderSettings { width: 0, ..base() },
+        ] {
+            assert!(bad.check().is_err(), "{bad:?}");
+        }
     }
 }

@@ -1,5 +1,6 @@
 //! Work counters. Tracing is generic over [`Counter`]: with [`NoCounts`]
 //! every increment compiles to nothing, so counting costs only when asked for.
+//! [`RenderCounts`] gathers what a render counted, tile by tile and in all.
 
 /// Receives one call per unit of work done for a ray.
 pub trait Counter {
@@ -85,5 +86,28 @@ impl std::ops::AddAssign for RayCounts {
         self.reflection += o.reflection;
         self.refraction += o.refraction;
         self.total_internal_reflections += o.total_internal_reflections;
+    }
+}
+
+/// What a render counted: rays by kind, Havran's work measures, and the
+/// samples that went wrong. Each tile counts its own; a pass and a whole
+/// frame sum them in tile order, so totals never depend on the threads.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RenderCounts {
+    pub rays: RayCounts,
+    pub work: WorkCounts,
+    /// Samples whose colour came out NaN or infinite (then shown black).
+    /// Always zero unless something is wrong: tests assert it.
+    pub nonfinite_samples: u64,
+    /// Pixels adaptive anti-aliasing refined with the full grid.
+    pub refined_pixels: u64,
+}
+
+impl std::ops::AddAssign for RenderCounts {
+    fn add_assign(&mut self, o: Self) {
+        self.refined_pixels += o.refined_pixels;
+        self.rays += o.rays;
+        self.work += o.work;
+        self.nonfinite_samples += o.nonfinite_samples;
     }
 }

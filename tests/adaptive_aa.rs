@@ -8,10 +8,10 @@ use glint::accel::Octree;
 use glint::frame::Frame;
 use glint::render::Renderer;
 use glint::scene::Scene;
-use glint::settings::{AntiAliasing, RenderSettings};
+use glint::settings::AntiAliasing;
 
 fn render(scene: &Scene, octree: &Octree, aa: AntiAliasing, w: u32, h: u32) -> (Frame, u64) {
-    let mut settings = RenderSettings::from_scene(scene);
+    let mut settings = scene.render_settings();
     (settings.width, settings.height) = (w, h);
     settings.set_anti_aliasing(aa);
     let (frame, counts) = Renderer::new(scene, octree, settings)
@@ -92,7 +92,7 @@ fn adaptive_is_within_45_db_of_the_full_grid_on_every_scene_kind() {
 fn adaptive_is_the_same_with_the_octree_off() {
     let scene = common::load("scenes/glass.toml");
     let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
-    let mut settings = RenderSettings::from_scene(&scene);
+    let mut settings = scene.render_settings();
     (settings.width, settings.height) = (96, 72);
     settings.set_anti_aliasing(AntiAliasing::Adaptive);
     let on = Renderer::new(&scene, &octree, settings)

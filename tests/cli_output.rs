@@ -246,10 +246,9 @@ fn limits_are_stated_when_refused() {
     );
     assert!(!Path::new("/tmp/never.png").exists());
     // The memory estimate, against a machine with 1 GiB available.
-    let mut settings =
-        glint::settings::RenderSettings::from_scene(&common::load("scenes/sphere.toml"));
+    let mut settings = common::load("scenes/sphere.toml").render_settings();
     (settings.width, settings.height) = (8192, 8192);
-    let e = glint::memory::check_memory_against(&settings, 0, 1 << 30)
+    let e = glint::render::memory::check_memory_against(&settings, 0, 1 << 30)
         .unwrap_err()
         .to_string();
     assert!(
@@ -257,5 +256,5 @@ fn limits_are_stated_when_refused() {
         "{e}"
     );
     (settings.width, settings.height) = (1024, 1024);
-    assert!(glint::memory::check_memory_against(&settings, 0, 1 << 30).is_ok());
+    assert!(glint::render::memory::check_memory_against(&settings, 0, 1 << 30).is_ok());
 }

@@ -9,7 +9,6 @@ use glint::camera::{Camera, CameraSpec};
 use glint::math::{DVec3, Ray};
 use glint::render::Renderer;
 use glint::scene::Scene;
-use glint::settings::RenderSettings;
 use glint::shapes::{PreparedRay, Quadric, Shape, Sphere, Triangle};
 use proptest::prelude::*;
 
@@ -339,7 +338,7 @@ fn extreme_cameras_and_image_shapes_see_what_the_pinhole_predicts() {
     assert!(Camera::new(&tilted.camera, 16, 16).is_ok());
     // ...exactly parallel is a clear error.
     tilted.camera.up = view;
-    let err = Renderer::new(&tilted, &octree, RenderSettings::from_scene(&tilted))
+    let err = Renderer::new(&tilted, &octree, tilted.render_settings())
         .err()
         .expect("an error");
     assert!(err.to_string().contains("parallel"), "{err}");
@@ -566,7 +565,7 @@ fn loads_cleanly_or_renders_finite(text: &str, name: &std::path::Path, what: &st
     let Ok(octree) = Octree::build(&scene.shapes, scene.octree_params) else {
         return true;
     };
-    let mut settings = RenderSettings::from_scene(&scene);
+    let mut settings = scene.render_settings();
     (settings.width, settings.height, settings.samples) = (16, 12, 1);
     if let Ok(renderer) = Renderer::new(&scene, &octree, settings) {
         let (_, counts) = renderer.render(false, None);

@@ -83,7 +83,7 @@ fn settings(scene: &Scene, view: ViewMode, use_octree: bool) -> RenderSettings {
     RenderSettings {
         view,
         use_octree,
-        ..RenderSettings::from_scene(scene)
+        ..scene.render_settings()
     }
 }
 
@@ -239,8 +239,9 @@ fn aa_need_view_agrees_with_the_study_measure() {
     let mut s = settings(&scene, ViewMode::AaNeed, true);
     s.width = 96;
     s.height = 72;
-    let (need, _) =
-        glint::render::render_view(&scene, &octree, s, &scene.camera, false, None).unwrap();
+    let (need, _) = Renderer::new(&scene, &octree, s)
+        .unwrap()
+        .render(false, None);
     let shaded = |samples| {
         let st = RenderSettings {
             samples,
@@ -380,7 +381,7 @@ fn trace_pixel_prints_the_tree_as_json() {
 #[test]
 fn records_outside_the_limits_are_refused() {
     let scene = common::load("scenes/sphere.toml");
-    let settings = RenderSettings::from_scene(&scene);
+    let settings = scene.render_settings();
     let dir = std::env::temp_dir().join(format!("glint-bad-record-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("bad.png");

@@ -10,7 +10,7 @@ use glint::material::{Light, Material};
 use glint::math::DVec3;
 use glint::render::Renderer;
 use glint::scene::{ImageSettings, Scene};
-use glint::settings::{RenderSettings, ViewMode};
+use glint::settings::ViewMode;
 use glint::shapes::{Plane, Quadric, Shape, Sphere};
 
 #[test]
@@ -96,7 +96,7 @@ fn head_on_plane_matches_the_analytic_colour() {
     }];
     scene.push(Shape::Plane(Plane::new(DVec3::ZERO, DVec3::Z)), 0);
     let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
-    let renderer = Renderer::new(&scene, &octree, RenderSettings::from_scene(&scene)).unwrap();
+    let renderer = Renderer::new(&scene, &octree, scene.render_settings()).unwrap();
     let (frame, _) = renderer.render(false, None);
     let centre = frame.pixels[4];
     let expected = 0.2 * material.color + (0.6 * material.color + DVec3::splat(0.1)) * 0.5;

@@ -12,7 +12,7 @@ use glint::camera::Camera;
 use glint::math::DVec3;
 use glint::render::Renderer;
 use glint::scene::Scene;
-use glint::settings::{RenderSettings, ViewMode};
+use glint::settings::ViewMode;
 
 fn scene_from(text: &str, name: &str) -> Scene {
     glint::scene::load_str(text, Path::new(name), &glint::scene::FileSystem)
@@ -61,7 +61,7 @@ fn assert_exact_coverage(polygon: &[DVec3], eye: DVec3, size: u32) {
     let scene = scene_from(&text, "polygon.nff");
     assert_eq!(scene.dropped_polygons.total(), 0, "the polygon is simple");
     let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
-    let mut settings = RenderSettings::from_scene(&scene);
+    let mut settings = scene.render_settings();
     settings.view = ViewMode::Depth;
     let renderer = Renderer::new(&scene, &octree, settings).unwrap();
     let (frame, _) = renderer.render(false, None);
@@ -361,7 +361,7 @@ fn tree_is_the_same_for_any_number_of_threads() {
             .build()
             .unwrap();
         let tree = pool.install(|| Octree::build(&scene.shapes, params).unwrap());
-        (tree.stats(), tree.cells(glint::accel::MAX_OCTREE_DEPTH))
+        (tree.stats(), tree.cells(glint::limits::MAX_OCTREE_DEPTH))
     };
     let one = build(1);
     assert!(one.0.leaves_stopped_by_budget > 0, "the budget binds");
@@ -455,7 +455,7 @@ fn through(glass: &str, light_x: f64) -> f64 {
     );
     let scene = scene_from(&text, "glass.nff");
     let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
-    let mut settings = RenderSettings::from_scene(&scene);
+    let mut settings = scene.render_settings();
     settings.max_depth = 1;
     let renderer = Renderer::new(&scene, &octree, settings).unwrap();
     let tree = renderer.ray_tree(4, 4);
@@ -545,7 +545,7 @@ fn records_of_large_scenes_keep_standard_text_chunks_small() {
     let scene = glint::scene::load(&path).unwrap();
     assert!(scene.source_text.len() > 1 << 20);
     let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
-    let mut settings = RenderSettings::from_scene(&scene);
+    let mut settings = scene.render_settings();
     (settings.width, settings.height) = (8, 8);
     let renderer = Renderer::new(&scene, &octree, settings).unwrap();
     let (frame, _) = renderer.render(false, None);

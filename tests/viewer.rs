@@ -10,9 +10,10 @@ use std::time::Duration;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use glint::accel::Octree;
+use glint::frame::rgba_to_rgb;
 use glint::render::Renderer;
-use glint::settings::RenderSettings;
-use glint::viewer::worker::{Job, PassKind, Worker, rgba_to_rgb};
+use glint::settings::AntiAliasing;
+use glint::viewer::worker::{Job, PassKind, Worker};
 use glint::viewer::{GlintApp, SceneSource, ViewerOptions};
 
 const WAIT: Duration = Duration::from_secs(60);
@@ -60,7 +61,11 @@ fn toggling_octree_and_anti_aliasing_restarts_the_passes() {
     h.get_by_label("Anti-aliasing (16 samples, 4x4 grid)")
         .click();
     h.run_steps(2);
-    assert_eq!(h.state().anti_aliasing(), !aa);
+    assert_ne!(h.state().anti_aliasing(), aa);
+    assert!(
+        [aa, h.state().anti_aliasing()].contains(&AntiAliasing::Off),
+        "the checkbox turns anti-aliasing on or off"
+    );
     assert!(h.state().worker().generation() > after_octree);
 }
 
@@ -120,56 +125,81 @@ fn job(
     scene: &str,
     width: u32,
     height: u32,
-    anti_aliasing: bool,
+    anti_aliasing: AntiAliasing,
 ) -> (Job, Arc<glint::scene::Scene>, Arc<Octree>) {
     let scene = Arc::new(common::load(scene));
     let octree = Arc::new(Octree::build(&scene.shapes, scene.octree_params).unwrap());
-    let mut settings = RenderSettings::from_scene(&scene);
+    let mut settings = scene.render_settings();
     settings.width = width;
     settings.height = height;
+    settings.set_anti_aliasing(anti_aliasing);
     let job = Job {
         scene: Arc::clone(&scene),
         octree: Arc::clone(&octree),
         camera: scene.camera,
         settings,
-        anti_aliasing,
         preview: None,
     };
     (job, scene, octree)
 }
 
+/// The worker shows each pass of the engine's plan, and the buffer it ends
+/// on is exactly the frame `glint render` writes: the tiles it swept in
+/// were replaced by the finished frame.
 #[test]
-fn passes_run_one_then_sixteen_and_the_final_buffer_equals_the_cli_render() {
+fn each_plan_shows_its_passes_and_ends_on_the_cli_frame() {
     let worker = Worker::spawn(2, || {});
-    let (job, scene, octree) = job("scenes/glass.toml", 96, 72, true);
-    let settings = job.settings;
-    let generation = worker.submit(job);
-    assert!(worker.wait_finished(generation, WAIT));
-    let kinds: Vec<PassKind> = worker
-        .history()
-        .iter()
-        .filter(|r| r.generation == generation)
-        .map(|r| r.kind)
-        .collect();
-    assert_eq!(kinds, vec![PassKind::OneSample, PassKind::SixteenSamples]);
-    // What `glint render --samples 16` computes for the same settings.
-    let cli = Renderer::new(
-        &scene,
-        &octree,
-        RenderSettings {
-            samples: 16,
-            ..settings
-        },
-    )
-    .unwrap()
-    .render(false, None)
-    .0
-    .to_rgb8();
-    let shown: Vec<u8> = worker.with_buffer(|b| rgba_to_rgb(&b.rgba));
-    assert!(
-        shown == cli,
-        "the finished 16-sample buffer is byte-identical to the CLI render"
-    );
+    let spd = glint::settings::Protocol::Spd;
+    let cases = [
+        (
+            "scenes/glass.toml",
+            AntiAliasing::Full,
+            None,
+            vec![PassKind::OneSample, PassKind::SixteenSamples],
+        ),
+        (
+            "scenes/default.toml",
+            AntiAliasing::Adaptive,
+            None,
+            vec![PassKind::OneSample, PassKind::SixteenSamples],
+        ),
+        (
+            "scenes/spd/sizes/balls_s1.nff",
+            AntiAliasing::Off,
+            Some(spd),
+            vec![PassKind::Corners],
+        ),
+    ];
+    for (scene_file, aa, protocol, expected) in cases {
+        let (mut job, scene, octree) = job(scene_file, 120, 90, aa);
+        if let Some(p) = protocol {
+            job.settings = job.settings.with_protocol(p);
+        }
+        let settings = job.settings;
+        let generation = worker.submit(job);
+        assert!(worker.wait_finished(generation, WAIT));
+        let passes: Vec<_> = worker
+            .history()
+            .into_iter()
+            .filter(|r| r.generation == generation)
+            .collect();
+        let kinds: Vec<PassKind> = passes.iter().map(|r| r.kind).collect();
+        assert_eq!(kinds, expected, "{scene_file}");
+        let (frame, counts) = Renderer::new(&scene, &octree, settings)
+            .unwrap()
+            .render(false, None);
+        let last = passes.last().unwrap();
+        assert_eq!(last.refined_pixels.is_some(), aa == AntiAliasing::Adaptive);
+        if let Some(refined) = last.refined_pixels {
+            assert!(refined > 0 && refined < 120 * 90);
+            assert_eq!(refined, counts.refined_pixels);
+        }
+        let shown: Vec<u8> = worker.with_buffer(|b| rgba_to_rgb(&b.rgba));
+        assert!(
+            shown == frame.to_rgb8(),
+            "{scene_file}: the finished buffer equals the CLI render"
+        );
+    }
 }
 
 #[test]
@@ -177,7 +207,7 @@ fn a_new_job_cancels_the_old_one_within_a_tile() {
     let threads = 2;
     let worker = Worker::spawn(threads, || {});
     // Big enough to take a while: 16 samples at 640x480 of the glass scene.
-    let (slow, _, _) = job("scenes/glass.toml", 640, 480, true);
+    let (slow, _, _) = job("scenes/glass.toml", 640, 480, AntiAliasing::Full);
     let first = worker.submit(slow);
     // Wait until the first pass has produced some tiles.
     let start = std::time::Instant::now();
@@ -185,7 +215,7 @@ fn a_new_job_cancels_the_old_one_within_a_tile() {
         assert!(start.elapsed() < WAIT);
         std::thread::sleep(Duration::from_millis(1));
     }
-    let (quick, _, _) = job("scenes/sphere.toml", 32, 24, false);
+    let (quick, _, _) = job("scenes/sphere.toml", 32, 24, AntiAliasing::Off);
     let started_at_cancel = worker.tiles_started(first);
     let second = worker.submit(quick);
     assert!(worker.wait_finished(second, WAIT));
@@ -194,7 +224,7 @@ fn a_new_job_cancels_the_old_one_within_a_tile() {
         total_first <= started_at_cancel + threads as u64,
         "after cancellation at most one more tile per thread: {started_at_cancel} then {total_first}"
     );
-    let tiles_in_full_job = 2 * glint::tiles::tiles(640, 480).len() as u64;
+    let tiles_in_full_job = 2 * glint::render::tiles::tiles(640, 480).len() as u64;
     assert!(
         total_first < tiles_in_full_job,
         "the first job did not run to completion"
@@ -249,7 +279,11 @@ fn pin_as_a_then_octree_off_reads_zero_pixels_differ() {
     h.get_by_label("Anti-aliasing (16 samples, 4x4 grid)")
         .click();
     h.run_steps(2);
-    assert_eq!(h.state().anti_aliasing(), !aa);
+    assert_ne!(h.state().anti_aliasing(), aa);
+    assert!(
+        [aa, h.state().anti_aliasing()].contains(&AntiAliasing::Off),
+        "the checkbox turns anti-aliasing on or off"
+    );
     settle(&mut h);
     let stats = h.state().compare_stats().unwrap();
     assert!(
@@ -351,17 +385,17 @@ fn viewer_exports_render_again_identically_from_their_metadata() {
         unedited,
         "the edit shows in the image"
     );
-    // Shaded with edits, then a diagnostic view, aa-need without
-    // anti-aliasing (a shaded frame), and the octree overlay.
+    // Shaded with edits, then a diagnostic view, aa-need (its 1- and
+    // 16-sample passes' difference), and the octree overlay.
     type Setup = Box<dyn Fn(&mut GlintApp)>;
     let cases: [(&str, Setup); 4] = [
         ("shaded, edited", Box::new(|_| {})),
         ("cost", Box::new(|a| a.settings_mut().view = ViewMode::Cost)),
         (
-            "aa-need, AA off",
+            "aa-need",
             Box::new(|a| {
                 a.settings_mut().view = ViewMode::AaNeed;
-                a.set_anti_aliasing(false);
+                a.set_anti_aliasing(AntiAliasing::Off);
             }),
         ),
         (
@@ -390,9 +424,9 @@ fn viewer_exports_render_again_identically_from_their_metadata() {
 }
 
 #[test]
-fn protocol_spd_in_the_viewer_is_one_corner_pass_equal_to_the_cli() {
+fn protocol_spd_in_the_viewer_is_one_corner_pass() {
     let mut app = app_for("scenes/spd/sizes/balls_s1.nff", 48, 40);
-    app.set_anti_aliasing(true);
+    app.set_anti_aliasing(AntiAliasing::Full);
     let mut h = harness(app);
     // NFF scenes shade display values by default; the panel says so.
     assert_eq!(
@@ -424,49 +458,18 @@ fn protocol_spd_in_the_viewer_is_one_corner_pass_equal_to_the_cli() {
     );
     let record = h.state().worker().history().last().copied().unwrap();
     assert_eq!(record.rays.primary, 49 * 41, "every corner once");
-    let scene = common::load("scenes/spd/sizes/balls_s1.nff");
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
-    let cli = Renderer::new(&scene, &octree, settings)
-        .unwrap()
-        .render(false, None)
-        .0
-        .to_rgb8();
-    let shown: Vec<u8> = h.state().worker().with_buffer(|b| rgba_to_rgb(&b.rgba));
-    assert!(
-        shown == cli,
-        "the corner pass equals `glint render --protocol spd`"
-    );
-}
-
-#[test]
-fn adaptive_refinement_pass_equals_the_cli_adaptive_render() {
-    let worker = Worker::spawn(2, || {});
-    let (mut job, scene, octree) = job("scenes/default.toml", 120, 90, true);
-    job.settings.adaptive = true;
-    let settings = job.settings;
-    let generation = worker.submit(job);
-    assert!(worker.wait_finished(generation, WAIT));
-    let last = worker.history().last().copied().unwrap();
-    assert_eq!(last.kind, PassKind::SixteenSamples);
-    let refined = last.refined_pixels.expect("an adaptive pass");
-    assert!(refined > 0 && refined < 120 * 90);
-    let mut cli_settings = settings;
-    cli_settings.set_anti_aliasing(glint::settings::AntiAliasing::Adaptive);
-    let (frame, counts) = Renderer::new(&scene, &octree, cli_settings)
-        .unwrap()
-        .render(false, None);
-    assert_eq!(counts.refined_pixels, refined);
-    let shown: Vec<u8> = worker.with_buffer(|b| rgba_to_rgb(&b.rgba));
-    assert!(
-        shown == frame.to_rgb8(),
-        "the viewer's adaptive pass equals `glint render --aa adaptive`"
-    );
+    // Back to glint's rules: the scene's own depth and sides return.
+    h.get_by_label("glint").click();
+    h.run_steps(2);
+    let scene = common::load("scenes/spd/sizes/balls_s1.nff").render_settings();
+    assert_eq!(h.state().settings().max_depth, scene.max_depth);
+    assert_eq!(h.state().settings().sides, scene.sides);
 }
 
 #[test]
 fn a_budget_preview_drops_what_it_says() {
     let worker = Worker::spawn(2, || {});
-    let (mut job, _, _) = job("scenes/glass.toml", 96, 72, true);
+    let (mut job, _, _) = job("scenes/glass.toml", 96, 72, AntiAliasing::Full);
     let preview = glint::viewer::worker::Preview {
         divisor: 2,
         reflections: false,

@@ -6,8 +6,7 @@ mod octree;
 mod primitives;
 
 pub use octree::{
-    DEFAULT_MEMORY_BUDGET_MIB, MAX_MEMORY_BUDGET_MIB, MAX_OCTREE_DEPTH, Octree, OctreeCell,
-    OctreeError, OctreeParams, OctreeStats,
+    DEFAULT_MEMORY_BUDGET_MIB, Octree, OctreeCell, OctreeError, OctreeParams, OctreeStats,
 };
 pub use primitives::{
     ClosestHit, MAX_SHADOW_CROSSINGS, Primitives, ShadowCrossings, closest_brute_force,

@@ -32,9 +32,7 @@ use crate::math::{Aabb, DVec3};
 use crate::shapes::{PreparedRay, Shape};
 use crate::stats::Counter;
 
-/// Deepest octree level glint builds: 2^21 cells per axis is far below
-/// any useful resolution and keeps build recursion shallow.
-pub const MAX_OCTREE_DEPTH: u32 = 21;
+use crate::limits::{LimitError, MAX_DUPLICATION_RANGE, MAX_MEMORY_BUDGET_MIB, MAX_OCTREE_DEPTH};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct OctreeParams {
@@ -62,10 +60,6 @@ pub const DEFAULT_MAX_DUPLICATION: u32 = 8;
 /// build finishes in seconds even when a scene would use it all.
 pub const DEFAULT_MEMORY_BUDGET_MIB: u32 = 128;
 
-/// Largest budget glint accepts: references are 31-bit counts and 32-bit
-/// indices.
-pub const MAX_MEMORY_BUDGET_MIB: u32 = 4096;
-
 fn default_max_duplication() -> u32 {
     DEFAULT_MAX_DUPLICATION
 }
@@ -92,6 +86,23 @@ impl Default for OctreeParams {
 }
 
 impl OctreeParams {
+    /// Every parameter within [`crate::limits`].
+    pub fn check(&self) -> Result<(), LimitError> {
+        if self.max_depth > MAX_OCTREE_DEPTH {
+            return Err(LimitError::OctreeDepth(self.max_depth));
+        }
+        if self.leaf_size == 0 {
+            return Err(LimitError::LeafSize);
+        }
+        if !MAX_DUPLICATION_RANGE.contains(&self.max_duplication) {
+            return Err(LimitError::MaxDuplication(self.max_duplication));
+        }
+        if !(1..=MAX_MEMORY_BUDGET_MIB).contains(&self.memory_budget_mib) {
+            return Err(LimitError::MemoryBudget(self.memory_budget_mib));
+        }
+        Ok(())
+    }
+
     fn memory_budget_bytes(&self) -> u64 {
         self.memory_budget_mib as u64 * 1024 * 1024
     }

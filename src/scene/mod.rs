@@ -12,10 +12,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 pub use mesh::{FileSystem, MeshSource};
-pub use model::{
-    AntiAliasing, ImageSettings, Location, MAX_IMAGE_SIDE, MAX_PIXELS, MAX_RAY_DEPTH, Scene,
-    SceneError, Sides,
-};
+pub use model::{ImageSettings, Location, Scene, SceneError};
 pub use polygon::DroppedPolygons;
 
 /// Loads a `.toml` or `.nff` scene file.

@@ -10,52 +10,10 @@ use crate::camera::CameraSpec;
 use crate::color::ColorConvention;
 use crate::material::{Light, Material};
 use crate::math::{Aabb, Color, DVec3};
+use crate::settings::{Protocol, RenderSettings, Sides, ViewMode};
 use crate::shapes::{Shape, Triangle};
 
 use super::polygon::{DroppedPolygons, triangulate};
-
-/// Which sides of a surface rays can hit.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Sides {
-    /// Every surface is seen from both sides (glint's default).
-    #[default]
-    Two,
-    /// Opaque surfaces are seen from outside only, as the SPD allows (a
-    /// ray meeting one from behind passes on). Transparent surfaces, and
-    /// triangles with vertex normals (NFF `pp` patches, smooth meshes:
-    /// tessellated open surfaces such as the SPD's teapot, which the SPD
-    /// requires two-sided) stay two-sided.
-    One,
-}
-
-impl Sides {
-    pub const ALL: [Sides; 2] = [Sides::Two, Sides::One];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Sides::Two => "two",
-            Sides::One => "one",
-        }
-    }
-}
-
-impl std::str::FromStr for Sides {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Self::ALL
-            .into_iter()
-            .find(|p| p.name() == s)
-            .ok_or_else(|| format!("unknown sidedness `{s}` (expected one or two)"))
-    }
-}
-
-/// Largest image side, pixel count and recursion depth glint accepts,
-/// from a file, the command line or a record: beyond these a typo would
-/// ask for gigabytes or recurse without end.
-pub const MAX_IMAGE_SIDE: u32 = 1 << 15;
-pub const MAX_PIXELS: u64 = 1 << 28;
-pub const MAX_RAY_DEPTH: u32 = 64;
 
 /// Image and recursion settings stored with a scene; command-line flags and
 /// the viewer override them.
@@ -125,6 +83,25 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// The settings the scene file asks for: its image size, samples,
+    /// depth, colours and sides, the octree switch; glint's protocol and the
+    /// shaded view. Command-line flags and the viewer override them.
+    pub fn render_settings(&self) -> RenderSettings {
+        RenderSettings {
+            width: self.image.width,
+            height: self.image.height,
+            samples: self.image.samples,
+            max_depth: self.image.max_depth,
+            use_octree: self.octree_enabled,
+            view: ViewMode::Shaded,
+            protocol: Protocol::Glint,
+            colors: self.image.colors,
+            sides: self.image.sides,
+            adaptive: self.image.adaptive,
+            shadows: true,
+        }
+    }
+
     /// A scene with no materials, lights or shapes yet.
     pub fn empty(name: String, camera: CameraSpec, image: ImageSettings) -> Self {
         Self {
@@ -238,9 +215,9 @@ impl Scene {
     pub fn shape_counts(&self) -> Vec<(&'static str, usize)> {
         let mut counts: Vec<(&'static str, usize)> = Vec::new();
         for s in self.shapes.iter() {
-            match counts.iter_mut().find(|(k, _)| *k == s.kind_name()) {
+            match counts.iter_mut().find(|(k, _)| *k == s.kind().name()) {
                 Some((_, n)) => *n += 1,
-                None => counts.push((s.kind_name(), 1)),
+                None => counts.push((s.kind().name(), 1)),
             }
         }
         counts
@@ -290,45 +267,6 @@ pub enum SceneError {
     },
     #[error("{path}: unknown scene format (expected a .toml or .nff file)")]
     UnknownFormat { path: PathBuf },
-}
-
-/// Anti-aliasing, as the command line, the viewer and scene files name it.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum AntiAliasing {
-    /// One ray through each pixel's centre.
-    #[default]
-    Off,
-    /// The centre everywhere, the 4x4 grid where neighbours differ.
-    Adaptive,
-    /// The regular 4x4 grid in every pixel.
-    Full,
-}
-
-impl AntiAliasing {
-    pub const ALL: [AntiAliasing; 3] = [
-        AntiAliasing::Off,
-        AntiAliasing::Adaptive,
-        AntiAliasing::Full,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            AntiAliasing::Off => "off",
-            AntiAliasing::Adaptive => "adaptive",
-            AntiAliasing::Full => "full",
-        }
-    }
-}
-
-impl std::str::FromStr for AntiAliasing {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Self::ALL
-            .into_iter()
-            .find(|a| a.name() == s)
-            .ok_or_else(|| format!("unknown anti-aliasing `{s}` (expected off, adaptive or full)"))
-    }
 }
 
 /// 1-based line and column of a byte offset.

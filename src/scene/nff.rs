@@ -4,15 +4,16 @@
 
 use std::path::Path;
 
-use super::model::{ImageSettings, Location, MAX_IMAGE_SIDE, Scene, SceneError};
-use crate::camera::CameraSpec;
-use crate::color::ColorConvention;
 use std::ops::RangeInclusive;
 
-use crate::material::{
-    INTENSITY_RANGE, IOR_RANGE, Light, Material, SHININESS_RANGE, UNIT_RANGE, check_color,
+use super::model::{ImageSettings, Location, Scene, SceneError};
+use crate::camera::CameraSpec;
+use crate::color::ColorConvention;
+use crate::limits::{
+    INTENSITY_RANGE, IOR_RANGE, MAX_IMAGE_SIDE, SHININESS_RANGE, UNIT_RANGE, check_color,
     check_range,
 };
+use crate::material::{Light, Material};
 use crate::math::DVec3;
 use crate::shapes::{Cone, Shape, Sphere};
 

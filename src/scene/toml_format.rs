@@ -8,17 +8,16 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::mesh::{MeshSource, Placement, parse_obj};
-use super::model::{
-    AntiAliasing, ImageSettings, Location, MAX_IMAGE_SIDE, MAX_RAY_DEPTH, Scene, SceneError,
-    line_column,
-};
+use super::model::{ImageSettings, Location, Scene, SceneError, line_column};
 use crate::accel::OctreeParams;
 use crate::camera::CameraSpec;
-use crate::material::{
-    INTENSITY_RANGE, IOR_RANGE, Light, Material, SHININESS_RANGE, UNIT_RANGE, check_color,
-    check_range,
+use crate::limits::{
+    INTENSITY_RANGE, IOR_RANGE, MAX_IMAGE_SIDE, MAX_RAY_DEPTH, SHININESS_RANGE, UNIT_RANGE,
+    check_color, check_range,
 };
+use crate::material::{Light, Material};
 use crate::math::{Aabb, DVec3};
+use crate::settings::AntiAliasing;
 use crate::shapes::{Plane, Quadric, Shape, Sphere, Triangle};
 
 type Vec3 = Spanned<[f64; 3]>;
@@ -303,7 +302,7 @@ pub fn parse(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, S
         octree_params.max_depth = cx.integer(
             v,
             "octree.max_depth",
-            0..crate::accel::MAX_OCTREE_DEPTH as i64 + 1,
+            0..crate::limits::MAX_OCTREE_DEPTH as i64 + 1,
         )?;
     }
     if let Some(v) = &file.octree.leaf_size {
@@ -316,7 +315,7 @@ pub fn parse(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, S
         octree_params.memory_budget_mib = cx.integer(
             v,
             "octree.memory_budget_mib",
-            1..crate::accel::MAX_MEMORY_BUDGET_MIB as i64 + 1,
+            1..crate::limits::MAX_MEMORY_BUDGET_MIB as i64 + 1,
         )?;
     }
 

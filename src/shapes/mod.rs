@@ -17,6 +17,29 @@ pub use triangle::{Triangle, triangle_overlaps_box};
 
 use crate::math::{Aabb, DVec3, Ray};
 
+/// The kinds of shape, as messages and the ray tree's JSON name them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ShapeKind {
+    Sphere,
+    Plane,
+    Triangle,
+    Quadric,
+    Cone,
+}
+
+impl ShapeKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            ShapeKind::Sphere => "sphere",
+            ShapeKind::Plane => "plane",
+            ShapeKind::Triangle => "triangle",
+            ShapeKind::Quadric => "quadric",
+            ShapeKind::Cone => "cone",
+        }
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub enum Shape {
     Sphere(Sphere),
@@ -143,13 +166,13 @@ impl Shape {
         matches!(self, Shape::Triangle(t) if t.vertex_normals != triangle::NO_NORMALS)
     }
 
-    pub fn kind_name(&self) -> &'static str {
+    pub fn kind(&self) -> ShapeKind {
         match self {
-            Shape::Sphere(_) => "sphere",
-            Shape::Plane(_) => "plane",
-            Shape::Triangle(_) => "triangle",
-            Shape::Quadric(_) => "quadric",
-            Shape::Cone(_) => "cone",
+            Shape::Sphere(_) => ShapeKind::Sphere,
+            Shape::Plane(_) => ShapeKind::Plane,
+            Shape::Triangle(_) => ShapeKind::Triangle,
+            Shape::Quadric(_) => ShapeKind::Quadric,
+            Shape::Cone(_) => ShapeKind::Cone,
         }
     }
 }

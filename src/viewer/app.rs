@@ -13,13 +13,13 @@ use super::inspect::{Compare, CompareMode, DiffStats, InspectState, Inspection};
 use super::panels::{Message, RenderInfo};
 use super::screenshot::Screenshot;
 use super::state::EditState;
-pub use super::state::SceneSource;
+pub use super::state::{CompareSetting, SceneSource};
 use super::worker::{Job, Preview, Worker};
 use super::{budget, export, input, panels};
 use crate::accel::Octree;
 use crate::camera::CameraSpec;
 use crate::scene::Scene;
-use crate::settings::{AntiAliasing, RenderSettings, ViewMode};
+use crate::settings::{AntiAliasing, Overrides, RenderSettings};
 
 /// Start-up options of the viewer.
 #[derive(Clone, Debug, Default)]
@@ -31,12 +31,9 @@ pub struct ViewerOptions {
     pub frames: u32,
     /// Render threads (0 = one per core).
     pub threads: usize,
-    /// Initial settings that differ from the scene's (view mode, octree, AA).
-    pub view: Option<ViewMode>,
-    pub octree: Option<bool>,
-    pub anti_aliasing: Option<crate::settings::AntiAliasing>,
-    /// Image size overriding the scene's.
-    pub size: Option<(u32, u32)>,
+    /// Initial settings that differ from the scene's (size, view, octree,
+    /// anti-aliasing, protocol, colours, sides).
+    pub overrides: Overrides,
     /// Start with the octree overlay drawn down to this level.
     pub overlay_depth: Option<u32>,
     /// Start with this pixel's ray tree inspected.
@@ -46,18 +43,6 @@ pub struct ViewerOptions {
     pub compare: Option<CompareSetting>,
     /// Show the comparison as a difference rather than a split.
     pub compare_difference: bool,
-    /// Start with these rules instead of the scene's (the protocol first:
-    /// it sets its depth and sidedness).
-    pub protocol: Option<crate::settings::Protocol>,
-    pub colors: Option<crate::color::ColorConvention>,
-    pub sides: Option<crate::settings::Sides>,
-}
-
-/// A setting `--compare` flips for the A image.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum CompareSetting {
-    Octree,
-    AntiAliasing,
 }
 
 /// Everything that decides the rendered image; a change restarts the passes.
@@ -65,7 +50,6 @@ pub enum CompareSetting {
 struct RenderInputs {
     camera: CameraSpec,
     settings: RenderSettings,
-    anti_aliasing: bool,
     scene_version: u64,
     preview: Option<Preview>,
 }
@@ -102,46 +86,26 @@ impl GlintApp {
         options: ViewerOptions,
         repaint: impl Fn() + Send + Sync + 'static,
     ) -> anyhow::Result<Self> {
-        let scene = source.load()?;
+        let mut scene = source.load()?;
         let worker = Worker::spawn(options.threads, repaint);
-        let mut settings = RenderSettings::from_scene(&scene);
-        let aa = options.anti_aliasing.unwrap_or(settings.anti_aliasing());
-        let mut anti_aliasing = aa != AntiAliasing::Off;
-        settings.adaptive = aa == AntiAliasing::Adaptive;
-        if let Some(v) = options.view {
-            settings.view = v;
-        }
-        if let Some(o) = options.octree {
-            settings.use_octree = o;
-        }
-        if let Some((w, h)) = options.size {
-            (settings.width, settings.height) = (w, h);
-        }
-        if let Some(p) = options.protocol {
-            settings = settings.with_protocol(p);
-        }
-        if let Some(c) = options.colors {
-            settings.colors = c;
-        }
-        if let Some(s) = options.sides {
-            settings.sides = s;
-        }
+        let mut settings = scene.render_settings();
+        options
+            .overrides
+            .apply(&mut settings, &mut scene.octree_params);
         let (octree, build_seconds) = build_octree(&scene)?;
-        match options.compare {
-            Some(CompareSetting::Octree) => settings.use_octree = !settings.use_octree,
-            Some(CompareSetting::AntiAliasing) => anti_aliasing = !anti_aliasing,
-            None => {}
+        let mut edit = EditState {
+            camera: scene.camera,
+            source,
+            scene: Arc::new(scene),
+            scene_version: 0,
+            settings,
+            frame_budget_ms: 33.0,
+        };
+        if let Some(setting) = options.compare {
+            edit.flip(setting);
         }
         let mut app = Self {
-            edit: EditState {
-                camera: scene.camera,
-                source,
-                scene: Arc::new(scene),
-                scene_version: 0,
-                settings,
-                anti_aliasing,
-                frame_budget_ms: 33.0,
-            },
+            edit,
             octree: Arc::new(octree),
             build_seconds,
             worker,
@@ -175,13 +139,13 @@ impl GlintApp {
         &mut self.edit.settings
     }
 
-    pub fn anti_aliasing(&self) -> bool {
-        self.edit.anti_aliasing
+    pub fn anti_aliasing(&self) -> AntiAliasing {
+        self.edit.settings.anti_aliasing()
     }
 
-    /// Turns the 16-sample pass on or off; a change restarts the passes.
-    pub fn set_anti_aliasing(&mut self, on: bool) {
-        self.edit.anti_aliasing = on;
+    /// Sets the anti-aliasing; a change restarts the passes.
+    pub fn set_anti_aliasing(&mut self, aa: AntiAliasing) {
+        self.edit.settings.set_anti_aliasing(aa);
     }
 
     /// Shows the octree overlay down to `depth`, or hides it (`None`);
@@ -407,11 +371,7 @@ impl GlintApp {
         {
             c.mode = CompareMode::Difference;
         }
-        let edit = &mut self.edit;
-        match setting {
-            CompareSetting::Octree => edit.settings.use_octree = !edit.settings.use_octree,
-            CompareSetting::AntiAliasing => edit.anti_aliasing = !edit.anti_aliasing,
-        }
+        self.edit.flip(setting);
         self.compare_pending = None;
     }
 
@@ -430,7 +390,6 @@ impl GlintApp {
         let inputs = RenderInputs {
             camera: edit.camera,
             settings: edit.settings,
-            anti_aliasing: edit.anti_aliasing,
             scene_version: edit.scene_version,
             preview: preview.map(|(p, _)| p),
         };
@@ -442,7 +401,6 @@ impl GlintApp {
             octree: Arc::clone(&self.octree),
             camera: edit.camera,
             settings: edit.settings,
-            anti_aliasing: edit.anti_aliasing,
             preview: inputs.preview,
         });
         self.submitted = Some(inputs);
@@ -536,7 +494,7 @@ impl GlintApp {
             edit.settings = RenderSettings {
                 view: edit.settings.view,
                 use_octree: edit.settings.use_octree,
-                ..RenderSettings::from_scene(&scene)
+                ..scene.render_settings()
             }
             .with_protocol(edit.settings.protocol);
         }

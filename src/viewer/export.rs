@@ -4,9 +4,10 @@
 use std::path::{Path, PathBuf};
 
 use super::state::SceneSource;
-use super::worker::{Worker, rgba_to_rgb};
+use super::worker::Worker;
 use crate::accel::Octree;
-use crate::export::{RenderRecord, SceneEdits};
+use crate::export::{OverlayRequest, RenderRecord, SceneEdits, save_frame};
+use crate::frame::rgba_to_rgb;
 
 /// The path to export to: chosen in a save dialog, or, where no dialog is
 /// available, a timestamped name in a place made for pictures. `None` when
@@ -63,16 +64,15 @@ pub fn export_to(
         materials: shown.scene.materials.clone(),
     });
     match frame {
-        Some(f) if finished && f.width == w && f.height == h => match overlay_depth {
-            Some(depth) => {
-                record.settings.overlay_depth = Some(depth);
-                let camera = crate::camera::Camera::new(&shown.camera, w, h)?;
-                let cells = octree.cells(depth);
-                let (rgb, height) = crate::overlay::annotate(&f, &camera, &cells, depth);
-                crate::export::save_rgb_png(path, w, height, &rgb, Some(&record))?
-            }
-            None => crate::export::save_png(&f, path, Some(&record))?,
-        },
+        Some(f) if finished && f.width == w && f.height == h => {
+            let camera = crate::camera::Camera::new(&shown.camera, w, h)?;
+            let overlay = overlay_depth.map(|depth| OverlayRequest {
+                octree,
+                camera: &camera,
+                depth,
+            });
+            save_frame(&f, path, &mut record, overlay)?
+        }
         _ => {
             record.settings.partial = true;
             let rgb = rgba_to_rgb(&rgba);

@@ -12,7 +12,7 @@ use super::worker::{PassKind, PassRecord, Worker};
 use crate::accel::{Octree, OctreeCell};
 use crate::camera::Camera;
 use crate::math::DVec3;
-use crate::ray_tree::{RayKind, RayNode};
+use crate::ray_tree::{RayKind, RayNode, ShadowVerdict};
 use crate::render::{RenderError, Renderer};
 use crate::settings::{RenderSettings, ViewMode};
 
@@ -461,10 +461,10 @@ fn draw_tree(
                 continue;
             };
             let color = match s.verdict {
-                "lit" => Color32::from_rgb(255, 230, 80),
-                "attenuated" => Color32::from_rgb(200, 160, 60),
-                "blocked" => Color32::from_rgb(200, 40, 40),
-                _ => continue,
+                ShadowVerdict::Lit => Color32::from_rgb(255, 230, 80),
+                ShadowVerdict::Attenuated => Color32::from_rgb(200, 160, 60),
+                ShadowVerdict::Blocked => Color32::from_rgb(200, 40, 40),
+                ShadowVerdict::FacesAway => continue,
             };
             segment(
                 painter,
@@ -509,7 +509,10 @@ fn node_ui(ui: &mut egui::Ui, node: &RayNode, path: &str) {
     let what = match &node.hit {
         Some(h) => format!(
             "{} #{} ({}) at {:.4}",
-            h.kind, h.object, h.material, h.distance
+            h.kind.name(),
+            h.object,
+            h.material,
+            h.distance
         ),
         None => "background".into(),
     };
@@ -535,7 +538,7 @@ fn node_ui(ui: &mut egui::Ui, node: &RayNode, path: &str) {
             ui.label(format!(
                 "light {}: {} (transmittance {:.3}) adds {}",
                 s.light,
-                s.verdict,
+                s.verdict.name(),
                 s.transmittance,
                 rgb_text(s.color)
             ));
@@ -568,7 +571,7 @@ pub fn inspect_controls_ui(
         ui.checkbox(&mut overlay, "Octree overlay");
         let mut depth = inspect.overlay_depth.unwrap_or(3);
         ui.label("to depth");
-        ui.add(egui::DragValue::new(&mut depth).range(0..=crate::accel::MAX_OCTREE_DEPTH));
+        ui.add(egui::DragValue::new(&mut depth).range(0..=crate::limits::MAX_OCTREE_DEPTH));
         inspect.overlay_depth = overlay.then_some(depth);
     });
     ui.checkbox(&mut inspect.inspect_mode, "Inspect: click picks a pixel");

@@ -13,7 +13,7 @@ use super::worker::{PassKind, PassRecord, Preview, Worker};
 use crate::accel::Octree;
 use crate::color::ColorConvention;
 use crate::math::DVec3;
-use crate::settings::{Protocol, RenderSettings, Sides, ViewMode};
+use crate::settings::{Protocol, Sides, ViewMode};
 
 /// A message shown in the status bar.
 #[derive(Clone, Debug)]
@@ -124,28 +124,27 @@ pub fn controls_ui(
                                 Protocol::Spd => "the SPD test protocol: rays through the pixel corners, depth 5, a reflection ray from every reflective or transmitting surface, opaque surfaces one-sided",
                             });
                     }
-                    if protocol != edit.settings.protocol {
-                        edit.settings = match protocol {
-                            // Back to glint's rules: the scene's own depth and sidedness.
-                            Protocol::Glint => RenderSettings {
-                                protocol,
-                                max_depth: edit.scene.image.max_depth,
-                                sides: edit.scene.image.sides,
-                                ..edit.settings
-                            },
-                            Protocol::Spd => edit.settings.with_protocol(protocol),
-                        };
-                    }
+                    edit.settings = edit
+                        .settings
+                        .switch_protocol(protocol, &edit.scene.render_settings());
                 });
+                // Off keeps whether anti-aliasing is adaptive, for when it
+                // is turned on again.
+                let mut anti_aliasing = edit.settings.samples > 1;
+                if ui
+                    .add_enabled(
+                        !spd,
+                        egui::Checkbox::new(
+                            &mut anti_aliasing,
+                            "Anti-aliasing (16 samples, 4x4 grid)",
+                        ),
+                    )
+                    .changed()
+                {
+                    edit.settings.samples = if anti_aliasing { 16 } else { 1 };
+                }
                 ui.add_enabled(
-                    !spd,
-                    egui::Checkbox::new(
-                        &mut edit.anti_aliasing,
-                        "Anti-aliasing (16 samples, 4x4 grid)",
-                    ),
-                );
-                ui.add_enabled(
-                    !spd && edit.anti_aliasing,
+                    !spd && anti_aliasing,
                     egui::Checkbox::new(
                         &mut edit.settings.adaptive,
                         "only where the picture needs it (adaptive)",
@@ -269,7 +268,7 @@ pub fn controls_ui(
                             .num_columns(2)
                             .show(ui, |ui| {
                                 // The ranges scene files are held to.
-                                use crate::material::{IOR_RANGE, SHININESS_RANGE, UNIT_RANGE};
+                                use crate::limits::{IOR_RANGE, SHININESS_RANGE, UNIT_RANGE};
                                 for (label, value, range, step) in [
                                     ("kd", &mut m.kd, UNIT_RANGE, 0.005),
                                     ("ks", &mut m.ks, UNIT_RANGE, 0.005),
@@ -378,7 +377,7 @@ fn timing_grid_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
                     "1-sample pass",
                     one.map_or(pending.into(), |r| format!("{:.3} s", r.seconds)),
                 );
-                if edit.anti_aliasing || sixteen.is_some() {
+                if edit.settings.samples > 1 || sixteen.is_some() {
                     row(
                         "16-sample pass",
                         sixteen.map_or(pending.into(), |r| format!("{:.3} s", r.seconds)),
@@ -611,10 +610,6 @@ pub fn status_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
             None => {
                 ui.label("rendering…");
             }
-        }
-        if edit.settings.view == ViewMode::AaNeed && !edit.anti_aliasing {
-            ui.separator();
-            ui.label("aa-need compares the 1- and 16-sample passes: turn anti-aliasing on");
         }
         if let Some(m) = info.message {
             ui.separator();

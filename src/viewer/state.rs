@@ -9,6 +9,13 @@ use crate::camera::CameraSpec;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 
+/// A setting `--compare` flips for the A image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CompareSetting {
+    Octree,
+    AntiAliasing,
+}
+
 /// Where the current scene came from.
 #[derive(Clone, Debug, PartialEq)]
 pub enum SceneSource {
@@ -53,9 +60,9 @@ pub struct EditState {
     /// Bumped whenever the scene changes, so the app can tell.
     pub scene_version: u64,
     pub camera: CameraSpec,
+    /// What to render; with anti-aliasing, the 16-sample pass follows the
+    /// 1-sample one.
     pub settings: RenderSettings,
-    /// The 16-sample pass after the 1-sample one.
-    pub anti_aliasing: bool,
     /// Target time of a preview pass while the user drags (milliseconds).
     pub frame_budget_ms: f64,
 }
@@ -67,13 +74,25 @@ impl EditState {
         Arc::make_mut(&mut self.scene)
     }
 
+    /// Flips a setting the A/B comparison compares: the octree on/off, or
+    /// anti-aliasing on/off (keeping whether it is adaptive).
+    pub fn flip(&mut self, setting: CompareSetting) {
+        let s = &mut self.settings;
+        match setting {
+            CompareSetting::Octree => s.use_octree = !s.use_octree,
+            CompareSetting::AntiAliasing => {
+                s.samples = if s.samples > 1 { 1 } else { 16 };
+            }
+        }
+    }
+
     /// The settings in one line, as the A/B comparison labels its images.
     pub fn settings_label(&self) -> String {
         let s = &self.settings;
         format!(
             "{}, AA {}, octree {}, depth {}, {}x{}",
             s.view.name(),
-            if self.anti_aliasing { "on" } else { "off" },
+            s.anti_aliasing().name(),
             if s.use_octree { "on" } else { "off" },
             s.max_depth,
             s.width,

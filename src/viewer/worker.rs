@@ -12,27 +12,24 @@ use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use rayon::prelude::*;
-
 use crate::accel::Octree;
 use crate::camera::CameraSpec;
-use crate::frame::Frame;
-use crate::math::DVec3;
-use crate::render::Renderer;
+use crate::frame::{Frame, rgb_to_rgba};
+use crate::render::{
+    FinishedPass, PassInfo, PassOptions, PassWatch, Renderer, TilePixels, tiles::Tile,
+};
 use crate::scene::Scene;
-use crate::settings::{RenderSettings, ViewMode};
+use crate::settings::RenderSettings;
 use crate::stats::RayCounts;
-use crate::tiles::{TileCounts, tiles};
 
-/// What to render. `settings.samples` is ignored: the worker runs the
-/// 1-sample pass, then the 16-sample pass if `anti_aliasing`.
+/// What to render: the frame of `settings` (with anti-aliasing, its
+/// 1-sample pass first, then the 16-sample pass).
 #[derive(Clone)]
 pub struct Job {
     pub scene: Arc<Scene>,
     pub octree: Arc<Octree>,
     pub camera: CameraSpec,
     pub settings: RenderSettings,
-    pub anti_aliasing: bool,
     /// Render only a quick 1-sample pass (while the user drags), at
     /// 1/`divisor` of the resolution and as simplified as the frame budget
     /// chose; `None`: the full progressive sequence.
@@ -50,6 +47,17 @@ pub enum PassKind {
 }
 
 impl PassKind {
+    /// How the viewer names a pass of the library's engine.
+    fn of(pass: crate::render::PassKind, preview: Option<Preview>) -> Self {
+        use crate::render::PassKind as Engine;
+        match (pass, preview) {
+            (_, Some(p)) => PassKind::Preview(p),
+            (Engine::OneSample, None) => PassKind::OneSample,
+            (Engine::Grid | Engine::Refine, None) => PassKind::SixteenSamples,
+            (Engine::Corners, None) => PassKind::Corners,
+        }
+    }
+
     pub fn label(self) -> String {
         match self {
             PassKind::Preview(p) => format!("preview {}", p.describe()),
@@ -154,11 +162,6 @@ impl std::fmt::Debug for FrameSource {
     }
 }
 
-/// The 1-sample frame of the generation being refined, kept by the worker
-/// to measure what the 16-sample pass changes, with the signatures of what
-/// each pixel's ray met (for adaptive anti-aliasing; empty otherwise).
-type OneSampleFrame = Mutex<Option<(u64, Frame, Vec<u64>)>>;
-
 struct Shared {
     generation: AtomicU64,
     buffer: Mutex<DisplayBuffer>,
@@ -169,7 +172,6 @@ struct Shared {
     tiles_started: Mutex<Vec<(u64, u64)>>,
     /// When the UI was last asked to repaint for new tiles.
     last_repaint: Mutex<Instant>,
-    one_sample: OneSampleFrame,
     /// What went wrong in the worker, for the status bar (taken by the UI).
     failure: Mutex<Option<String>>,
 }
@@ -217,7 +219,6 @@ impl Worker {
             started: Instant::now(),
             tiles_started: Mutex::new(Vec::new()),
             last_repaint: Mutex::new(Instant::now()),
-            one_sample: Mutex::new(None),
             failure: Mutex::new(None),
         });
         let (tx, rx) = channel();
@@ -344,230 +345,165 @@ fn run(shared: Arc<Shared>, rx: Receiver<(u64, Job)>, threads: usize) {
 }
 
 fn render_job(shared: &Shared, generation: u64, job: &Job) {
-    let passes: Vec<PassKind> = if let Some(preview) = job.preview {
-        vec![PassKind::Preview(preview)]
-    } else if job.settings.corner_rays() {
-        // The SPD protocol has one way to sample: no refinement pass.
-        vec![PassKind::Corners]
-    } else if job.anti_aliasing {
-        vec![PassKind::OneSample, PassKind::SixteenSamples]
-    } else {
-        vec![PassKind::OneSample]
-    };
-    let last = passes.len() - 1;
-    for (index, &kind) in passes.iter().enumerate() {
-        let mut settings = job.settings;
-        settings.samples = if kind == PassKind::SixteenSamples {
-            16
-        } else {
-            1
-        };
-        if let PassKind::Preview(p) = kind {
-            settings.width = (settings.width / p.divisor).max(1);
-            settings.height = (settings.height / p.divisor).max(1);
-            if !p.reflections {
-                settings.max_depth = 1;
-            }
-            settings.shadows = p.shadows;
+    let mut settings = job.settings;
+    if let Some(p) = job.preview {
+        settings.set_anti_aliasing(crate::settings::AntiAliasing::Off);
+        settings.width = (settings.width / p.divisor).max(1);
+        settings.height = (settings.height / p.divisor).max(1);
+        if !p.reflections {
+            settings.max_depth = 1;
         }
-        if !render_pass(shared, generation, job, settings, kind, index == last) {
-            return;
-        }
-    }
-}
-
-/// Renders one pass; `false` if it was cancelled.
-fn render_pass(
-    shared: &Shared,
-    generation: u64,
-    job: &Job,
-    settings: RenderSettings,
-    kind: PassKind,
-    last: bool,
-) -> bool {
-    let stale = || shared.generation.load(Ordering::SeqCst) != generation;
-    // The aa-need view renders shaded passes and shows their difference
-    // once the 16-sample pass is done.
-    let shown_view = settings.view;
-    let mut settings = settings;
-    if shown_view == ViewMode::AaNeed {
-        settings.view = ViewMode::Shaded;
+        settings.shadows = p.shadows;
     }
     let renderer = match Renderer::with_camera(&job.scene, &job.octree, settings, &job.camera) {
         Ok(r) => r,
         Err(e) => {
             shared.fail(format!("cannot render: {e}"));
-            return false;
+            return;
         }
     };
-    let (w, h) = (settings.width, settings.height);
-    let all = tiles(w, h);
-    // A preview is shown only once complete (a half-swept preview is a torn
-    // frame), with its record; a full pass sweeps in over the previous
-    // image, first scaled to the new size if it differs (after a preview).
-    let preview = matches!(kind, PassKind::Preview(_));
-    // The aa-need difference exists only after a 16-sample pass; before
-    // it (and without anti-aliasing) the frame is the shaded picture.
-    let frame_view = if shown_view == ViewMode::AaNeed && kind != PassKind::SixteenSamples {
-        ViewMode::Shaded
-    } else {
-        shown_view
+    let watch = Display {
+        shared,
+        generation,
+        job,
+        settings,
+        done: AtomicU64::new(0),
     };
-    let source = FrameSource {
-        scene: Arc::clone(&job.scene),
-        camera: job.camera,
-        settings: RenderSettings {
-            view: frame_view,
-            ..settings
-        },
+    let options = PassOptions {
+        count_work: false,
+        progressive: job.preview.is_none(),
     };
-    {
-        let mut b = shared.buffer.lock().unwrap_or_else(|e| e.into_inner());
+    renderer.render_frame(options, &watch);
+}
+
+/// Shows a job's passes: tiles sweep into the display buffer as they
+/// finish (a preview only once complete: a half-swept preview is a torn
+/// frame), each finished pass replaces them with its exact frame.
+struct Display<'a> {
+    shared: &'a Shared,
+    generation: u64,
+    job: &'a Job,
+    settings: RenderSettings,
+    /// Tiles of the current pass on screen.
+    done: AtomicU64,
+}
+
+impl Display<'_> {
+    fn stale(&self) -> bool {
+        self.shared.generation.load(Ordering::SeqCst) != self.generation
+    }
+
+    fn buffer(&self) -> std::sync::MutexGuard<'_, DisplayBuffer> {
+        self.shared.buffer.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The inputs of a pass, as an export records them: the pass's own
+    /// sampling (1 sample for the first pass) and the view its frame holds.
+    fn source(&self, pass: &PassInfo, frame_view: crate::settings::ViewMode) -> FrameSource {
+        let mut settings = self.settings;
+        if pass.kind == crate::render::PassKind::OneSample {
+            settings.set_anti_aliasing(crate::settings::AntiAliasing::Off);
+        }
+        settings.view = frame_view;
+        FrameSource {
+            scene: Arc::clone(&self.job.scene),
+            camera: self.job.camera,
+            settings,
+        }
+    }
+}
+
+impl PassWatch for Display<'_> {
+    fn start_tile(&self, _pass: &PassInfo) -> bool {
+        // The cancellation point: at most one tile per thread is wasted.
+        if self.stale() {
+            return false;
+        }
+        count_tile(self.shared, self.generation);
+        true
+    }
+
+    fn shows_tiles(&self) -> bool {
+        self.job.preview.is_none()
+    }
+
+    fn pass_started(&self, pass: &PassInfo) {
+        self.done.store(0, Ordering::Relaxed);
+        let (w, h) = (pass.width, pass.height);
+        let preview = self.job.preview.is_some();
+        let mut b = self.buffer();
+        // A full pass sweeps in over the previous image, first scaled to
+        // the new size if it differs (after a preview).
         if !preview && (b.width != w || b.height != h || b.rgba.len() != (w * h * 4) as usize) {
             b.rgba = resample_rgba(&b.rgba, b.width, b.height, w, h);
             b.width = w;
             b.height = h;
         }
-        b.generation = generation;
-        b.pass = Some(kind);
+        b.generation = self.generation;
+        b.pass = Some(PassKind::of(pass.kind, self.job.preview));
         if !preview {
-            b.source = Some(source.clone());
+            b.source = Some(self.source(pass, pass.view));
         }
         b.tiles_done = 0;
-        b.tiles_total = all.len() as u64;
+        b.tiles_total = pass.tiles;
         b.finished = false;
         b.version += 1;
     }
-    // Adaptive anti-aliasing: the 1-sample pass keeps what each pixel's ray
-    // met, the 16-sample pass refines where that or the picture has an edge.
-    let adaptive = settings.anti_aliasing() == crate::settings::AntiAliasing::Adaptive
-        || (kind == PassKind::OneSample && job.settings.adaptive && job.anti_aliasing);
-    let first_pass = if kind == PassKind::SixteenSamples && adaptive {
-        let one = shared.one_sample.lock().unwrap_or_else(|e| e.into_inner());
-        one.as_ref()
-            .filter(|(g, f, sig)| *g == generation && f.pixels.len() == sig.len() && f.width == w)
-            .map(|(_, f, sig)| {
-                let mask = crate::adaptive::refine_mask(&f.to_rgb8(), sig, w, h);
-                (f.pixels.clone(), mask)
-            })
-    } else {
-        None
-    };
-    let signatures = Mutex::new(if kind == PassKind::OneSample && adaptive {
-        vec![0u64; (w * h) as usize]
-    } else {
-        Vec::new()
-    });
-    let start = Instant::now();
-    let done = AtomicU64::new(0);
-    let depth_range = Mutex::new((f64::INFINITY, f64::NEG_INFINITY));
-    let results: Vec<Option<(Vec<DVec3>, TileCounts)>> = all
-        .par_iter()
-        .map(|&tile| {
-            // The cancellation point: at most one tile per thread is wasted.
-            if stale() {
-                return None;
-            }
-            count_tile(shared, generation);
-            let (values, counts) = match &first_pass {
-                Some((pixels, mask)) => renderer.refine_tile(tile, pixels, mask, false),
-                None if kind == PassKind::OneSample && adaptive => {
-                    let (values, sig, counts) = renderer.first_pass_tile(tile, false);
-                    let mut all_sig = signatures.lock().unwrap_or_else(|e| e.into_inner());
-                    crate::tiles::place_tile(&mut all_sig, w, &tile, &sig);
-                    (values, counts)
-                }
-                None => renderer.render_tile(tile, false),
-            };
-            let rgba = tile_rgba(&values, &settings, &depth_range);
-            if !matches!(kind, PassKind::Preview(_)) {
-                let mut b = shared.buffer.lock().unwrap_or_else(|e| e.into_inner());
-                if b.generation == generation && b.width == w {
-                    for row in 0..tile.height {
-                        let dst = (((tile.y + row) * w + tile.x) * 4) as usize;
-                        let src = (row * tile.width * 4) as usize;
-                        let n = (tile.width * 4) as usize;
-                        b.rgba[dst..dst + n].copy_from_slice(&rgba[src..src + n]);
-                    }
-                    b.tiles_done = done.fetch_add(1, Ordering::Relaxed) + 1;
-                    b.version += 1;
-                }
-            }
-            shared.repaint_soon();
-            Some((values, counts))
-        })
-        .collect();
-    if stale() || results.iter().any(Option::is_none) {
-        return false;
-    }
-    let seconds = start.elapsed().as_secs_f64();
-    // Assemble the exact frame, as `glint render` would, and publish it.
-    let (frame, counts) =
-        crate::tiles::assemble_tiles(&settings, &all, results.into_iter().flatten());
-    let one_sample_error = {
-        let mut one = shared.one_sample.lock().unwrap_or_else(|e| e.into_inner());
-        match kind {
-            PassKind::OneSample => {
-                let sig =
-                    std::mem::take(&mut *signatures.lock().unwrap_or_else(|e| e.into_inner()));
-                *one = Some((generation, frame.clone(), sig));
-                None
-            }
-            PassKind::SixteenSamples => one
-                .as_ref()
-                .filter(|(g, f, _)| *g == generation && f.pixels.len() == frame.pixels.len())
-                .map(|(_, f, _)| {
-                    crate::metrics::image_error(&f.pixels, &frame.pixels, frame.colors)
-                }),
-            PassKind::Preview(_) | PassKind::Corners => None,
-        }
-    };
-    let frame = match (shown_view, kind) {
-        (ViewMode::AaNeed, PassKind::SixteenSamples) => {
-            let one = shared.one_sample.lock().unwrap_or_else(|e| e.into_inner());
-            match one.as_ref() {
-                Some((g, f, _)) if *g == generation && f.pixels.len() == frame.pixels.len() => {
-                    Frame::aa_need(f, &frame)
-                }
-                _ => frame,
+
+    fn tile_done(&self, pass: &PassInfo, tile: &Tile, pixels: Option<&TilePixels>) {
+        let Some(pixels) = pixels else { return };
+        let rgba = pixels.rgba();
+        {
+            let mut b = self.buffer();
+            if b.generation == self.generation && b.width == pass.width {
+                crate::render::tiles::place_tile(&mut b.rgba, pass.width, tile, &rgba, 4);
+                b.tiles_done = self.done.fetch_add(1, Ordering::Relaxed) + 1;
+                b.version += 1;
             }
         }
-        _ => frame,
-    };
-    let rgba = rgb_to_rgba(&frame.to_rgb8());
-    {
-        let mut b = shared.buffer.lock().unwrap_or_else(|e| e.into_inner());
-        if b.generation != generation {
-            return false;
+        self.shared.repaint_soon();
+    }
+
+    fn pass_done(&self, pass: &FinishedPass) {
+        if self.stale() {
+            return;
         }
-        b.rgba = rgba;
-        b.width = w;
-        b.height = h;
-        b.source = Some(source);
-        b.finished = last;
-        b.last_frame = Some(frame);
-        b.version += 1;
+        let frame = pass.frame;
+        let rgba = rgb_to_rgba(&frame.to_rgb8());
+        {
+            let mut b = self.buffer();
+            if b.generation != self.generation {
+                return;
+            }
+            b.rgba = rgba;
+            b.width = frame.width;
+            b.height = frame.height;
+            b.source = Some(self.source(&pass.info, frame.view));
+            b.finished = pass.info.is_last();
+            b.last_frame = Some(frame.clone());
+            b.version += 1;
+        }
+        let summary = pass.summary;
+        if let Ok(mut history) = self.shared.history.lock() {
+            history.push(PassRecord {
+                generation: self.generation,
+                kind: PassKind::of(pass.info.kind, self.job.preview),
+                seconds: summary.seconds,
+                rays: summary.counts.rays,
+                octree: self.settings.use_octree,
+                anti_aliasing: self.job.settings.samples > 1,
+                width: frame.width,
+                height: frame.height,
+                finished_at: self.shared.started.elapsed().as_secs_f64(),
+                one_sample_error: summary.one_sample_error,
+                refined_pixels: summary.refined_pixels,
+                view: self.job.settings.view,
+                max_depth: self.settings.max_depth,
+                protocol: self.settings.protocol,
+            });
+        }
+        (self.shared.repaint)();
     }
-    if let Ok(mut history) = shared.history.lock() {
-        history.push(PassRecord {
-            generation,
-            kind,
-            seconds,
-            rays: counts.rays,
-            octree: settings.use_octree,
-            anti_aliasing: job.anti_aliasing,
-            width: w,
-            height: h,
-            finished_at: shared.started.elapsed().as_secs_f64(),
-            one_sample_error,
-            refined_pixels: first_pass.is_some().then_some(counts.refined_pixels),
-            view: shown_view,
-            max_depth: settings.max_depth,
-            protocol: settings.protocol,
-        });
-    }
-    (shared.repaint)();
-    true
 }
 
 fn count_tile(shared: &Shared, generation: u64) {
@@ -585,61 +521,6 @@ fn count_tile(shared: &Shared, generation: u64) {
             }
         }
     }
-}
-
-/// Display bytes of one tile. Depth is normalised by the nearest distance
-/// seen so far, cost by the range seen so far; the finished pass replaces
-/// them with the exact full frame.
-fn tile_rgba(
-    values: &[DVec3],
-    settings: &RenderSettings,
-    depth_range: &Mutex<(f64, f64)>,
-) -> Vec<u8> {
-    let view = settings.view;
-    let rgb = match view {
-        ViewMode::Cost | ViewMode::CostSteps => {
-            let range = {
-                let mut r = depth_range.lock().unwrap_or_else(|e| e.into_inner());
-                for v in values {
-                    let c = crate::frame::cost_value(*v, view);
-                    r.0 = r.0.min(c);
-                    r.1 = r.1.max(c);
-                }
-                *r
-            };
-            values
-                .iter()
-                .flat_map(|v| {
-                    crate::legend::viridis(crate::frame::cost_shade(
-                        crate::frame::cost_value(*v, view),
-                        range,
-                    ))
-                })
-                .collect()
-        }
-        ViewMode::Depth => {
-            let near = {
-                let mut r = depth_range.lock().unwrap_or_else(|e| e.into_inner());
-                if values.iter().any(|v| v.y > 0.0) {
-                    r.0 = r.0.min(crate::frame::nearest_depth(values));
-                }
-                r.0
-            };
-            values
-                .iter()
-                .flat_map(|v| [(crate::frame::depth_shade(*v, near) * 255.0).round() as u8; 3])
-                .collect()
-        }
-        _ => Frame {
-            width: values.len() as u32,
-            height: 1,
-            view,
-            colors: settings.colors,
-            pixels: values.to_vec(),
-        }
-        .to_rgb8(),
-    };
-    rgb_to_rgba(&rgb)
 }
 
 /// An RGBA image scaled to `w x h` by nearest neighbour (opaque black when
@@ -663,21 +544,6 @@ fn resample_rgba(rgba: &[u8], from_w: u32, from_h: u32, w: u32, h: u32) -> Vec<u
     out
 }
 
-pub fn rgb_to_rgba(rgb: &[u8]) -> Vec<u8> {
-    let mut out = Vec::with_capacity(rgb.len() / 3 * 4);
-    for p in rgb.chunks_exact(3) {
-        out.extend_from_slice(&[p[0], p[1], p[2], 255]);
-    }
-    out
-}
-
-/// The display buffer's pixels without alpha, as a PNG stores them.
-pub fn rgba_to_rgb(rgba: &[u8]) -> Vec<u8> {
-    rgba.chunks_exact(4)
-        .flat_map(|p| [p[0], p[1], p[2]])
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -697,45 +563,6 @@ mod tests {
         assert_eq!(resample_rgba(&big, 4, 4, 2, 2), rgba);
         // Nothing usable (a buffer of another size): opaque black.
         assert_eq!(resample_rgba(&rgba, 3, 3, 1, 1), [0, 0, 0, 255]);
-    }
-
-    #[test]
-    fn a_tile_of_the_shaded_view_encodes_like_the_whole_frame() {
-        let settings = RenderSettings {
-            width: 3,
-            height: 1,
-            samples: 1,
-            max_depth: 5,
-            use_octree: true,
-            view: ViewMode::Shaded,
-            protocol: crate::settings::Protocol::Glint,
-            colors: crate::color::ColorConvention::Linear,
-            sides: crate::settings::Sides::Two,
-            adaptive: false,
-            shadows: true,
-        };
-        let values = [
-            DVec3::new(0.0, 0.5, 1.0),
-            DVec3::new(2.0, -1.0, 0.25),
-            DVec3::splat(0.0031308),
-        ];
-        let range = Mutex::new((f64::INFINITY, f64::NEG_INFINITY));
-        let tile = tile_rgba(&values, &settings, &range);
-        // sRGB encoding (IEC 61966-2-1) of each channel, clamped to [0, 1].
-        let srgb = |x: f64| {
-            let x = x.clamp(0.0, 1.0);
-            let e = if x <= 0.0031308 {
-                12.92 * x
-            } else {
-                1.055 * x.powf(1.0 / 2.4) - 0.055
-            };
-            (e * 255.0).round() as u8
-        };
-        let expected: Vec<u8> = values
-            .iter()
-            .flat_map(|v| [srgb(v.x), srgb(v.y), srgb(v.z), 255])
-            .collect();
-        assert_eq!(tile, expected);
     }
 
     #[test]

@@ -7,7 +7,7 @@ use glint::accel::Octree;
 use glint::render::Renderer;
 use glint::scene::Scene;
 use glint::settings::RenderSettings;
-use glint::tiles::TileCounts;
+use glint::stats::RenderCounts;
 
 pub fn repo_path(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
@@ -52,8 +52,8 @@ pub fn render_with(
     width: u32,
     height: u32,
     adjust: impl FnOnce(&mut RenderSettings),
-) -> (Vec<u8>, TileCounts) {
-    let mut settings = RenderSettings::from_scene(scene);
+) -> (Vec<u8>, RenderCounts) {
+    let mut settings = scene.render_settings();
     settings.width = width;
     settings.height = height;
     adjust(&mut settings);

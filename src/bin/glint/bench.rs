@@ -6,8 +6,8 @@ use std::time::Instant;
 use anyhow::{Result, bail};
 use glint::accel::{Octree, OctreeStats};
 use glint::render::Renderer;
-use glint::settings::RenderSettings;
-use glint::tiles::TileCounts;
+use glint::settings::{Overrides, RenderSettings};
+use glint::stats::RenderCounts;
 use serde::Serialize;
 
 use crate::common::{
@@ -129,38 +129,7 @@ struct SceneBench {
     /// The SPD's published counts for this scene (default SPD scenes at
     /// 512x512 under `--protocol spd` only).
     #[serde(skip_serializing_if = "Option::is_none")]
-    published: Option<PublishedCounts>,
-}
-
-/// Ray counts the SPD Readme publishes for its default scenes (513 x 513
-/// eye rays; `spd_protocol.md`), which a ray tracer following its rules
-/// should reproduce within about 10%.
-#[derive(Clone, Copy, Debug, Serialize)]
-struct PublishedCounts {
-    eye_hits: u64,
-    reflection: u64,
-    refraction: u64,
-    shadow: u64,
-}
-
-fn published_counts(scene: &str) -> Option<PublishedCounts> {
-    let name = std::path::Path::new(scene).file_stem()?.to_str()?;
-    let (eye_hits, reflection, refraction, shadow) = match name {
-        "balls" => (263_169, 175_095, 0, 954_368),
-        "gears" => (245_086, 304_643, 207_564, 2_246_955),
-        "mount" => (173_125, 354_769, 354_769, 412_922),
-        "rings" => (263_169, 315_236, 0, 1_085_002),
-        "teapot" => (161_120, 225_248, 0, 407_656),
-        "tetra" => (49_788, 0, 0, 46_112),
-        "tree" => (169_836, 0, 0, 1_097_419),
-        _ => return None,
-    };
-    Some(PublishedCounts {
-        eye_hits,
-        reflection,
-        refraction,
-        shadow,
-    })
+    published: Option<glint::published::SpdCounts>,
 }
 
 fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
@@ -245,8 +214,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             let on_rows_s = if every > 1 { median(rows_on) } else { on_s };
             median(rows_off.clone()) / on_rows_s
         });
-        let per_ray = |c: &TileCounts, x: u64| x as f64 / c.rays.total().max(1) as f64;
-        let timing = |c: &TileCounts, seconds: f64, rays_in_time: f64, estimated: bool| Timing {
+        let per_ray = |c: &RenderCounts, x: u64| x as f64 / c.rays.total().max(1) as f64;
+        let timing = |c: &RenderCounts, seconds: f64, rays_in_time: f64, estimated: bool| Timing {
             render_s: seconds,
             mrays_per_s: rays_in_time / seconds.max(1e-12) / 1e6,
             intersection_tests_per_ray: per_ray(c, c.work.intersection_tests),
@@ -290,7 +259,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             protocol: settings.protocol,
             published: (settings.protocol == glint::settings::Protocol::Spd
                 && (settings.width, settings.height) == (512, 512))
-                .then(|| published_counts(&path.display().to_string()))
+                .then(|| glint::published::spd_counts(&stem(path)))
                 .flatten(),
         });
     }
@@ -306,20 +275,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     Ok(())
 }
 
-/// Havran's best published octree (Octree93-A, best maximum depth) on the
-/// default SPD scenes: intersection tests per ray, N_IT (Havran 1999).
-fn havran_best_nit(scene: &str) -> Option<f64> {
-    let name = std::path::Path::new(scene).file_stem()?.to_str()?;
-    Some(match name {
-        "balls" => 26.38,
-        "gears" => 65.44,
-        "mount" => 16.56,
-        "rings" => 31.81,
-        "teapot" => 47.91,
-        "tetra" => 24.08,
-        "tree" => 23.79,
-        _ => return None,
-    })
+/// A scene file's stem, as the published tables name the SPD scenes.
+fn stem(path: &std::path::Path) -> String {
+    path.file_stem()
+        .map_or(String::new(), |s| s.to_string_lossy().into_owned())
 }
 
 fn markdown(results: &[SceneBench]) -> String {
@@ -340,7 +299,8 @@ fn markdown(results: &[SceneBench]) -> String {
             Some(off) => format!("{:.2}", off.render_s),
         };
         let speedup = r.speedup.map_or("–".to_string(), |x| format!("{x:.1}x"));
-        let havran = havran_best_nit(&r.scene).map_or("".to_string(), |x| format!("{x:.2}"));
+        let havran = glint::published::havran_best_nit(&stem(std::path::Path::new(&r.scene)))
+            .map_or("".to_string(), |x| format!("{x:.2}"));
         s.push_str(&format!(
             "| {} | {} | {}x{} | {} | {:.3} | {:.3} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {:.2}x |\n",
             name,
@@ -451,7 +411,7 @@ fn sweep(args: &BenchArgs) -> Result<()> {
         }
         for (cost_driven, max_depth, leaf_size, max_duplication) in combinations {
             let params = glint::accel::OctreeParams {
-                max_depth: max_depth.min(glint::accel::MAX_OCTREE_DEPTH),
+                max_depth: max_depth.min(glint::limits::MAX_OCTREE_DEPTH),
                 leaf_size: leaf_size.max(1),
                 cost_driven,
                 max_duplication: max_duplication.clamp(1, 8),
@@ -525,20 +485,17 @@ fn print_sweep_row(r: &SweepRow) {
 /// The scene's settings with the command line's overrides applied (and its
 /// octree parameters to the scene).
 fn bench_settings(args: &BenchArgs, scene: &mut glint::scene::Scene) -> RenderSettings {
-    args.octree_params.apply(&mut scene.octree_params);
-    let mut settings = RenderSettings::from_scene(scene);
-    if let Some((w, h)) = args.size {
-        (settings.width, settings.height) = (w, h);
-    }
-    if let Some(samples) = args.samples {
-        settings.samples = samples;
-        settings.adaptive = false;
-    }
-    if let Some(aa) = args.aa {
-        settings.set_anti_aliasing(aa);
-    }
-    settings.max_depth = args.max_depth.unwrap_or(settings.max_depth);
-    args.rules.apply(&mut settings);
-    settings.view = args.view.unwrap_or(settings.view);
+    let mut overrides = Overrides {
+        width: args.size.map(|(w, _)| w),
+        height: args.size.map(|(_, h)| h),
+        anti_aliasing: crate::common::anti_aliasing(args.samples, args.aa),
+        max_depth: args.max_depth,
+        octree: args.octree_params.overrides(),
+        view: args.view,
+        ..Overrides::default()
+    };
+    args.rules.add_to(&mut overrides);
+    let mut settings = scene.render_settings();
+    overrides.apply(&mut settings, &mut scene.octree_params);
     settings
 }

@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use glint::scene::Scene;
+use glint::settings::{AntiAliasing, OctreeOverrides, Overrides};
 
 /// `on` / `off`, as the command line spells a switch.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -73,9 +74,9 @@ pub fn parse_samples(s: &str) -> std::result::Result<u32, String> {
 }
 
 /// `off`, `adaptive` or `full` (and the viewer's older `on` for full).
-pub fn parse_aa(s: &str) -> std::result::Result<glint::settings::AntiAliasing, String> {
+pub fn parse_aa(s: &str) -> std::result::Result<AntiAliasing, String> {
     match s {
-        "on" => Ok(glint::settings::AntiAliasing::Full),
+        "on" => Ok(AntiAliasing::Full),
         _ => s.parse(),
     }
 }
@@ -145,19 +146,23 @@ impl RulesArgs {
         Ok(())
     }
 
-    /// Applies the flags: the protocol first (it sets its depth and
-    /// sidedness), then explicit colour and sidedness choices.
-    pub fn apply(&self, settings: &mut glint::settings::RenderSettings) {
-        if let Some(p) = self.protocol {
-            *settings = settings.with_protocol(p);
-        }
-        if let Some(c) = self.colors {
-            settings.colors = c;
-        }
-        if let Some(s) = self.sides {
-            settings.sides = s;
-        }
+    /// Puts the flags into `overrides`.
+    pub fn add_to(&self, overrides: &mut Overrides) {
+        overrides.protocol = self.protocol;
+        overrides.colors = self.colors;
+        overrides.sides = self.sides;
     }
+}
+
+/// The anti-aliasing asked for by `--samples 1|16` (off or full) or `--aa`.
+pub fn anti_aliasing(samples: Option<u32>, aa: Option<AntiAliasing>) -> Option<AntiAliasing> {
+    aa.or(samples.map(|n| {
+        if n > 1 {
+            AntiAliasing::Full
+        } else {
+            AntiAliasing::Off
+        }
+    }))
 }
 
 /// Octree parameters on the command line; unset ones keep the scene's.
@@ -179,26 +184,18 @@ pub struct OctreeArgs {
     /// Memory budget of the octree in MiB (nodes and references, counted
     /// while it is built); past it, nodes stay leaves, which is correct but
     /// slower. Default 128.
-    #[arg(long, value_name = "MIB", value_parser = clap::value_parser!(u32).range(1..=glint::accel::MAX_MEMORY_BUDGET_MIB as i64))]
+    #[arg(long, value_name = "MIB", value_parser = clap::value_parser!(u32).range(1..=glint::limits::MAX_MEMORY_BUDGET_MIB as i64))]
     pub octree_memory_budget: Option<u32>,
 }
 
 impl OctreeArgs {
-    pub fn apply(&self, params: &mut glint::accel::OctreeParams) {
-        if let Some(d) = self.octree_max_depth {
-            params.max_depth = d.min(glint::accel::MAX_OCTREE_DEPTH);
-        }
-        if let Some(n) = self.octree_leaf_size {
-            params.leaf_size = n;
-        }
-        if let Some(c) = self.octree_cost_driven {
-            params.cost_driven = c.is_on();
-        }
-        if let Some(d) = self.octree_max_duplication {
-            params.max_duplication = d;
-        }
-        if let Some(m) = self.octree_memory_budget {
-            params.memory_budget_mib = m;
+    pub fn overrides(&self) -> OctreeOverrides {
+        OctreeOverrides {
+            max_depth: self.octree_max_depth,
+            leaf_size: self.octree_leaf_size,
+            cost_driven: self.octree_cost_driven.map(Switch::is_on),
+            max_duplication: self.octree_max_duplication,
+            memory_budget_mib: self.octree_memory_budget,
         }
     }
 }

@@ -6,8 +6,10 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use glint::accel::{Octree, OctreeStats};
-use glint::render::Renderer;
-use glint::settings::{RenderSettings, ViewMode};
+use glint::camera::CameraSpec;
+use glint::render::tiles::Tile;
+use glint::render::{PassInfo, PassOptions, PassWatch, RenderedFrame, Renderer, TilePixels};
+use glint::settings::{Overrides, RenderSettings, ViewMode};
 use glint::stats::RayCounts;
 use serde::Serialize;
 
@@ -174,7 +176,41 @@ struct RaysJson {
     total: u64,
 }
 
+/// A render ready to go: the scene, its octree and every setting, checked.
+struct Prepared {
+    scene: glint::scene::Scene,
+    scene_name: String,
+    settings: RenderSettings,
+    camera: CameraSpec,
+    octree: Octree,
+    overlay_depth: Option<u32>,
+    threads: usize,
+    pool: rayon::ThreadPool,
+    load_s: f64,
+    build_s: f64,
+}
+
 pub fn run(args: &RenderArgs) -> Result<()> {
+    let job = prepare(args)?;
+    if let Some((x, y)) = args.trace_pixel {
+        print_ray_tree(&job, x, y)?;
+    }
+    // With --trace-pixel alone the tree is all there is to do.
+    let Some(output) = &args.output else {
+        if args.trace_pixel.is_some() {
+            return Ok(());
+        }
+        anyhow::bail!("give an output file with -o");
+    };
+    let (rendered, render_s) = render(&job, args.stats)?;
+    save(&job, &rendered.frame, output)?;
+    report(args, &job, &rendered, output, render_s)
+}
+
+/// Checks the output, loads the scene (or the recorded one), applies the
+/// flags, builds the octree and checks the render fits in memory: every
+/// refusal comes before any rendering.
+fn prepare(args: &RenderArgs) -> Result<Prepared> {
     args.rules.check(args.max_depth, args.samples)?;
     // Check the output before any work: its name, and that it is not an input.
     if let Some(output) = &args.output {
@@ -192,59 +228,32 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut overlay_depth = args.overlay.map(|_| args.overlay_depth.unwrap_or(4));
     let (mut scene, scene_name, mut settings, camera) = match (&args.from_png, &args.scene) {
         (Some(png), _) => {
-            let record = glint::export::read_record(png)?;
-            if record.glint_version != env!("CARGO_PKG_VERSION") {
-                eprintln!(
-                    "note: {} was made by glint {}, this is {}: pixels may differ",
-                    png.display(),
-                    record.glint_version,
-                    env!("CARGO_PKG_VERSION")
-                );
+            let restored = glint::export::restore(png)
+                .with_context(|| format!("cannot render again what {} records", png.display()))?;
+            for note in &restored.notes {
+                eprintln!("note: {note}");
             }
-            let scene = glint::export::load_recorded_scene(&record)
-                .with_context(|| format!("cannot load the scene recorded in {}", png.display()))?;
-            let settings = record.settings.render;
-            overlay_depth = record
-                .settings
+            overlay_depth = restored
                 .overlay_depth
                 .map(|d| args.overlay_depth.unwrap_or(d))
                 .or(overlay_depth);
-            if record.settings.partial {
-                eprintln!(
-                    "note: {} was exported while a pass was still rendering; this renders the whole pass",
-                    png.display()
-                );
-            }
             (
-                scene,
-                record.scene_path.clone(),
-                settings,
-                record.settings.camera.into(),
+                restored.scene,
+                restored.scene_path,
+                restored.settings,
+                restored.camera,
             )
         }
         (None, Some(path)) => {
             let (scene, _) = load_scene(path)?;
-            let settings = RenderSettings::from_scene(&scene);
+            let settings = scene.render_settings();
             let camera = scene.camera;
             (scene, path.display().to_string(), settings, camera)
         }
         (None, None) => anyhow::bail!("give a scene file or --from-png"),
     };
     let load_s = load_start.elapsed().as_secs_f64();
-    args.octree_params.apply(&mut scene.octree_params);
-    settings.width = args.width.unwrap_or(settings.width);
-    settings.height = args.height.unwrap_or(settings.height);
-    if let Some(samples) = args.samples {
-        settings.samples = samples;
-        settings.adaptive = false;
-    }
-    if let Some(aa) = args.aa {
-        settings.set_anti_aliasing(aa);
-    }
-    settings.max_depth = args.max_depth.unwrap_or(settings.max_depth);
-    settings.use_octree = args.octree.map_or(settings.use_octree, Switch::is_on);
-    settings.view = args.view.unwrap_or(settings.view);
-    args.rules.apply(&mut settings);
+    overrides(args).apply(&mut settings, &mut scene.octree_params);
 
     let pool = thread_pool(args.threads)?;
     let threads = pool.current_num_threads();
@@ -256,22 +265,48 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         Octree::build(&[], scene.octree_params)?
     };
     let build_s = build_start.elapsed().as_secs_f64();
-
-    if let Some((x, y)) = args.trace_pixel {
-        print_ray_tree(&scene, &scene_name, &octree, settings, &camera, x, y)?;
+    if args.output.is_some() {
+        // Validate before starting.
+        Renderer::with_camera(&scene, &octree, settings, &camera)
+            .with_context(|| format!("cannot render {scene_name}"))?;
+        glint::render::memory::check_memory(&settings, octree.stats().memory_bytes)
+            .with_context(|| format!("cannot render {scene_name}"))?;
     }
-    // With --trace-pixel alone the tree is all there is to do.
-    let Some(output) = &args.output else {
-        if args.trace_pixel.is_some() {
-            return Ok(());
-        }
-        anyhow::bail!("give an output file with -o");
+    Ok(Prepared {
+        scene,
+        scene_name,
+        settings,
+        camera,
+        octree,
+        overlay_depth,
+        threads,
+        pool,
+        load_s,
+        build_s,
+    })
+}
+
+/// What the flags ask for instead of the scene's (or the record's) settings.
+fn overrides(args: &RenderArgs) -> Overrides {
+    let mut o = Overrides {
+        width: args.width,
+        height: args.height,
+        anti_aliasing: crate::common::anti_aliasing(args.samples, args.aa),
+        max_depth: args.max_depth,
+        use_octree: args.octree.map(Switch::is_on),
+        octree: args.octree_params.overrides(),
+        view: args.view,
+        ..Overrides::default()
     };
-    // Validate before starting (the aa-need view renders twice).
-    Renderer::with_camera(&scene, &octree, settings, &camera)
-        .with_context(|| format!("cannot render {scene_name}"))?;
-    glint::memory::check_memory(&settings, octree.stats().memory_bytes)
-        .with_context(|| format!("cannot render {scene_name}"))?;
+    args.rules.add_to(&mut o);
+    o
+}
+
+/// Renders every pass of the frame with a progress bar on a terminal;
+/// returns it and the seconds it took.
+fn render(job: &Prepared, count_work: bool) -> Result<(RenderedFrame, f64)> {
+    let renderer = Renderer::with_camera(&job.scene, &job.octree, job.settings, &job.camera)
+        .with_context(|| format!("cannot render {}", job.scene_name))?;
     let bar = std::io::stderr().is_terminal().then(|| {
         let bar = indicatif::ProgressBar::new(1);
         bar.set_style(
@@ -283,38 +318,64 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         );
         bar
     });
-    let progress = |done: u64, total: u64| {
-        if let Some(b) = &bar {
-            b.set_length(total);
-            b.set_position(done);
-        }
+    let watch = ProgressBar { bar: bar.as_ref() };
+    let options = PassOptions {
+        count_work,
+        progressive: false,
     };
-    let render_start = Instant::now();
-    let (frame, counts) = pool.install(|| {
-        glint::render::render_view(
-            &scene,
-            &octree,
-            settings,
-            &camera,
-            args.stats,
-            Some(&progress),
-        )
-    })?;
-    let render_s = render_start.elapsed().as_secs_f64();
+    let start = Instant::now();
+    let rendered = job
+        .pool
+        .install(|| renderer.render_frame(options, &watch))
+        .context("the render was abandoned")?;
+    let render_s = start.elapsed().as_secs_f64();
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    let mut record = glint::export::RenderRecord::new(&scene, &scene_name, &camera, settings);
-    match overlay_depth {
-        Some(depth) => {
-            record.settings.overlay_depth = Some(depth);
-            let view = glint::camera::Camera::new(&camera, settings.width, settings.height)?;
-            let (rgb, height) =
-                glint::overlay::annotate(&frame, &view, &octree.cells(depth), depth);
-            glint::export::save_rgb_png(output, frame.width, height, &rgb, Some(&record))?;
+    Ok((rendered, render_s))
+}
+
+/// Shows the frame's progress in tiles.
+struct ProgressBar<'a> {
+    bar: Option<&'a indicatif::ProgressBar>,
+}
+
+impl PassWatch for ProgressBar<'_> {
+    fn tile_done(&self, pass: &PassInfo, _tile: &Tile, _pixels: Option<&TilePixels>) {
+        if let Some(b) = self.bar {
+            b.set_length(pass.frame_tiles);
+            b.inc(1);
         }
-        None => glint::export::save_png(&frame, output, Some(&record))?,
     }
+}
+
+/// Writes the frame with its record (and the overlay, if asked for).
+fn save(job: &Prepared, frame: &glint::frame::Frame, output: &std::path::Path) -> Result<()> {
+    let s = &job.settings;
+    let mut record = glint::export::RenderRecord::new(&job.scene, &job.scene_name, &job.camera, *s);
+    let camera = glint::camera::Camera::new(&job.camera, s.width, s.height)?;
+    let overlay = job
+        .overlay_depth
+        .map(|depth| glint::export::OverlayRequest {
+            octree: &job.octree,
+            camera: &camera,
+            depth,
+        });
+    glint::export::save_frame(frame, output, &mut record, overlay)?;
+    Ok(())
+}
+
+/// The line on stderr, the notes about what the scene dropped, and the
+/// `--stats` JSON.
+fn report(
+    args: &RenderArgs,
+    job: &Prepared,
+    rendered: &RenderedFrame,
+    output: &std::path::Path,
+    render_s: f64,
+) -> Result<()> {
+    let (scene, settings, octree) = (&job.scene, &job.settings, &job.octree);
+    let (frame, counts) = (&rendered.frame, &rendered.counts);
     if !args.quiet {
         let written = match glint::export::OutputTarget::resolve(output)? {
             glint::export::OutputTarget::File(p) => std::fs::metadata(&p)
@@ -358,67 +419,61 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             octree.stats().leaves_stopped_by_budget
         );
     }
-    if args.stats {
-        let total = counts.rays.total();
-        let per_ray = |x: u64| {
-            if total > 0 {
-                x as f64 / total as f64
-            } else {
-                0.0
-            }
-        };
-        let stats = RenderStats {
-            scene: scene_name.clone(),
-            width: settings.width,
-            height: settings.height,
-            samples: settings.samples,
-            max_depth: settings.max_depth,
-            threads,
-            octree: settings.use_octree,
-            octree_params: scene.octree_params,
-            view: settings.view,
-            protocol: settings.protocol,
-            colors: settings.colors,
-            sides: settings.sides,
-            aa: settings.anti_aliasing(),
-            refined_pixels: counts.refined_pixels,
-            refined_fraction: counts.refined_pixels as f64
-                / (settings.width as f64 * settings.height as f64),
-            load_s,
-            build_s,
-            render_s,
-            rays: RaysJson {
-                counts: counts.rays,
-                total,
-            },
-            mrays_per_s: total as f64 / render_s.max(1e-9) / 1e6,
-            intersection_tests_per_ray: per_ray(counts.work.intersection_tests),
-            traversal_steps_per_ray: per_ray(counts.work.traversal_steps),
-            leaves_visited_per_ray: per_ray(counts.work.leaves_visited),
-            nonfinite_samples: counts.nonfinite_samples,
-            dropped_degenerate_triangles: scene.dropped_triangles,
-            dropped_polygons: scene.dropped_polygons,
-            octree_stats: settings.use_octree.then(|| octree.stats()),
-            cost_per_pixel: frame.cost_summary().map(|c| CostJson {
-                min: c.min,
-                max: c.max,
-                mean: c.mean,
-            }),
-        };
-        println!("{}", serde_json::to_string_pretty(&stats)?);
+    if !args.stats {
+        return Ok(());
     }
+    let total = counts.rays.total();
+    let per_ray = |x: u64| {
+        if total > 0 {
+            x as f64 / total as f64
+        } else {
+            0.0
+        }
+    };
+    let stats = RenderStats {
+        scene: job.scene_name.clone(),
+        width: settings.width,
+        height: settings.height,
+        samples: settings.samples,
+        max_depth: settings.max_depth,
+        threads: job.threads,
+        octree: settings.use_octree,
+        octree_params: scene.octree_params,
+        view: settings.view,
+        protocol: settings.protocol,
+        colors: settings.colors,
+        sides: settings.sides,
+        aa: settings.anti_aliasing(),
+        refined_pixels: counts.refined_pixels,
+        refined_fraction: counts.refined_pixels as f64
+            / (settings.width as f64 * settings.height as f64),
+        load_s: job.load_s,
+        build_s: job.build_s,
+        render_s,
+        rays: RaysJson {
+            counts: counts.rays,
+            total,
+        },
+        mrays_per_s: total as f64 / render_s.max(1e-9) / 1e6,
+        intersection_tests_per_ray: per_ray(counts.work.intersection_tests),
+        traversal_steps_per_ray: per_ray(counts.work.traversal_steps),
+        leaves_visited_per_ray: per_ray(counts.work.leaves_visited),
+        nonfinite_samples: counts.nonfinite_samples,
+        dropped_degenerate_triangles: scene.dropped_triangles,
+        dropped_polygons: scene.dropped_polygons,
+        octree_stats: settings.use_octree.then(|| octree.stats()),
+        cost_per_pixel: frame.cost_summary().map(|c| CostJson {
+            min: c.min,
+            max: c.max,
+            mean: c.mean,
+        }),
+    };
+    println!("{}", serde_json::to_string_pretty(&stats)?);
     Ok(())
 }
 
-fn print_ray_tree(
-    scene: &glint::scene::Scene,
-    scene_name: &str,
-    octree: &Octree,
-    mut settings: RenderSettings,
-    camera: &glint::camera::CameraSpec,
-    x: u32,
-    y: u32,
-) -> Result<()> {
+fn print_ray_tree(job: &Prepared, x: u32, y: u32) -> Result<()> {
+    let mut settings = job.settings;
     anyhow::ensure!(
         x < settings.width && y < settings.height,
         "pixel {x},{y} is outside the {}x{} image",
@@ -427,14 +482,14 @@ fn print_ray_tree(
     );
     settings.samples = 1;
     settings.view = ViewMode::Shaded;
-    let renderer = Renderer::with_camera(scene, octree, settings, camera)
-        .with_context(|| format!("cannot render {scene_name}"))?;
+    let renderer = Renderer::with_camera(&job.scene, &job.octree, settings, &job.camera)
+        .with_context(|| format!("cannot render {}", job.scene_name))?;
     let tree = renderer.ray_tree(x, y);
     let color = glam::DVec3::from_array(tree.color);
     let srgb8 =
         [color.x, color.y, color.z].map(|c| glint::color::to_byte(settings.colors.encode(c)));
     let out = TraceJson {
-        scene: scene_name.to_string(),
+        scene: job.scene_name.clone(),
         pixel: [x, y],
         width: settings.width,
         height: settings.height,
@@ -444,7 +499,8 @@ fn print_ray_tree(
         colors: settings.colors,
         color: tree.color,
         srgb8,
-        lights: scene
+        lights: job
+            .scene
             .lights
             .iter()
             .map(|l| LightJson {

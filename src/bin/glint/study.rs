@@ -121,7 +121,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
             .file_stem()
             .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
         eprintln!("study {}", path.display());
-        let mut base = RenderSettings::from_scene(&scene);
+        let mut base = scene.render_settings();
         (base.width, base.height) = (w, h);
         base.use_octree = true;
         let study = Study {

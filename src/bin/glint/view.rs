@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::{Result, anyhow};
-use glint::settings::ViewMode;
+use glint::settings::{Overrides, ViewMode};
 use glint::viewer::app::CompareSetting;
 use glint::viewer::{GlintApp, SceneSource, ViewerOptions};
 
@@ -93,14 +93,20 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     // Load once up front so a bad scene is a clear error, not a blank window.
     source.load()?;
     let (w, h) = (args.window.0 as f32, args.window.1 as f32);
+    let mut overrides = Overrides {
+        width: args.size.map(|(w, _)| w),
+        height: args.size.map(|(_, h)| h),
+        anti_aliasing: args.aa,
+        use_octree: args.octree.map(Switch::is_on),
+        view: args.view,
+        ..Overrides::default()
+    };
+    args.rules.add_to(&mut overrides);
     let options = ViewerOptions {
         screenshot: args.screenshot.clone(),
         frames: args.frames,
         threads: args.threads,
-        view: args.view,
-        octree: args.octree.map(Switch::is_on),
-        anti_aliasing: args.aa,
-        size: args.size,
+        overrides,
         overlay_depth: args.overlay_depth,
         inspect: args.inspect,
         compare: args.compare.map(|c| match c {
@@ -108,9 +114,6 @@ pub fn run(args: &ViewArgs) -> Result<()> {
             CompareArg::Aa => CompareSetting::AntiAliasing,
         }),
         compare_difference: args.compare_difference,
-        protocol: args.rules.protocol,
-        colors: args.rules.colors,
-        sides: args.rules.sides,
     };
     let native = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()

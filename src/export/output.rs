@@ -1,0 +1,175 @@
+//! Where an output's bytes go: standard output, a FIFO or device written
+//! directly, or a file written through a temporary file renamed into place
+//! (following symbolic links to their target).
+
+use std::path::{Path, PathBuf};
+
+use super::error::ExportError;
+use super::png_file::write_png;
+use super::record::RenderRecord;
+
+/// Where an output path's bytes go.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum OutputTarget {
+    /// `-`: standard output.
+    Stdout,
+    /// A FIFO, a character or block device or a socket: written directly,
+    /// never replaced.
+    Special(PathBuf),
+    /// A regular file (or a name not yet taken), after following symbolic
+    /// links: written to a temporary file next to it, renamed into place,
+    /// so a failed write never leaves a truncated image and a symbolic link
+    /// keeps pointing at its (updated) target.
+    File(PathBuf),
+}
+
+impl OutputTarget {
+    /// Resolves `path` (`-` for standard output).
+    pub fn resolve(path: &Path) -> Result<Self, ExportError> {
+        if path.as_os_str() == "-" {
+            return Ok(OutputTarget::Stdout);
+        }
+        use std::os::unix::fs::FileTypeExt;
+        match std::fs::metadata(path) {
+            Ok(m) => {
+                let t = m.file_type();
+                if t.is_fifo() || t.is_char_device() || t.is_block_device() || t.is_socket() {
+                    return Ok(OutputTarget::Special(path.to_owned()));
+                }
+                if t.is_dir() {
+                    return Err(ExportError::Write {
+                        path: path.to_owned(),
+                        source: std::io::Error::other("it is a directory"),
+                    });
+                }
+                // An existing file, possibly behind symbolic links.
+                let target = std::fs::canonicalize(path).map_err(|source| ExportError::Write {
+                    path: path.to_owned(),
+                    source,
+                })?;
+                Ok(OutputTarget::File(target))
+            }
+            Err(_) => Ok(OutputTarget::File(dangling_link_target(path))),
+        }
+    }
+
+    /// The regular file the output ends up in, if any.
+    pub fn file(&self) -> Option<&Path> {
+        match self {
+            OutputTarget::File(p) => Some(p),
+            _ => None,
+        }
+    }
+}
+
+/// Checks an output path before any work is done: a file must be named
+/// `.png` (glint writes PNG, and a PNG under another name misleads), and
+/// must not be the scene being rendered (`input`). Standard output, FIFOs
+/// and devices take PNG bytes whatever their name.
+pub fn check_output(path: &Path, input: Option<&Path>) -> Result<OutputTarget, ExportError> {
+    let target = OutputTarget::resolve(path)?;
+    if let Some(file) = target.file() {
+        let is_png = file
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        if !is_png {
+            return Err(ExportError::NotPng {
+                path: path.to_owned(),
+            });
+        }
+        if let Some(input) = input
+            && let Ok(input) = std::fs::canonicalize(input)
+            && input == file
+        {
+            return Err(ExportError::IsInput {
+                path: path.to_owned(),
+            });
+        }
+    }
+    Ok(target)
+}
+
+/// The file a new output named `path` creates: `path` itself, or the
+/// target of a symbolic link that points at a file not yet there.
+fn dangling_link_target(path: &Path) -> PathBuf {
+    let mut current = path.to_owned();
+    // Follow a bounded chain of links, as the kernel does.
+    for _ in 0..40 {
+        match std::fs::read_link(&current) {
+            Ok(target) => {
+                current = match current.parent() {
+                    Some(dir) if target.is_relative() => dir.join(target),
+                    _ => target,
+                };
+            }
+            Err(_) => return current,
+        }
+    }
+    current
+}
+
+/// Writes an RGB8 picture (already annotated) as PNG with its record:
+/// to standard output for `-`, straight into FIFOs and devices, and for
+/// files through a temporary file next to the target (following symbolic
+/// links) renamed into place.
+pub fn save_rgb_png(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgb: &[u8],
+    record: Option<&RenderRecord>,
+) -> Result<(), ExportError> {
+    let write_error = |source| ExportError::Write {
+        path: path.to_owned(),
+        source,
+    };
+    match OutputTarget::resolve(path)? {
+        OutputTarget::Stdout => {
+            use std::io::Write;
+            let mut bytes = Vec::new();
+            write_png(&mut bytes, path, width, height, rgb, record)?;
+            let mut out = std::io::stdout().lock();
+            out.write_all(&bytes)
+                .and_then(|()| out.flush())
+                .map_err(write_error)
+        }
+        OutputTarget::Special(p) => {
+            let file = std::fs::OpenOptions::new()
+                .write(true)
+                .open(&p)
+                .map_err(write_error)?;
+            let mut w = std::io::BufWriter::new(file);
+            write_png(&mut w, path, width, height, rgb, record)?;
+            use std::io::Write;
+            w.flush().map_err(write_error)
+        }
+        OutputTarget::File(target) => {
+            let dir = match target.parent() {
+                Some(d) if !d.as_os_str().is_empty() => d.to_owned(),
+                _ => PathBuf::from("."),
+            };
+            // A replaced file keeps its permissions; a new one gets the
+            // usual 0666 less the umask (tempfile's own default is 0600).
+            use std::os::unix::fs::PermissionsExt;
+            let permissions = std::fs::metadata(&target)
+                .map(|m| m.permissions())
+                .unwrap_or_else(|_| std::fs::Permissions::from_mode(0o666));
+            let tmp = tempfile::Builder::new()
+                .prefix(".glint-")
+                .suffix(".png.tmp")
+                .permissions(permissions)
+                .tempfile_in(&dir)
+                .map_err(write_error)?;
+            {
+                let mut w = std::io::BufWriter::new(tmp.as_file());
+                write_png(&mut w, path, width, height, rgb, record)?;
+                use std::io::Write;
+                w.flush().map_err(write_error)?;
+            }
+            // Dropped (and deleted) on any error above.
+            tmp.persist(&target).map_err(|e| write_error(e.error))?;
+            Ok(())
+        }
+    }
+}

@@ -1,0 +1,150 @@
+//! The record an exported PNG carries: how the image was made, enough to
+//! make it again. Its keywords and JSON field names are part of the file
+//! format: add, never rename.
+
+use serde::{Deserialize, Serialize};
+
+use crate::accel::OctreeParams;
+use crate::camera::CameraSpec;
+use crate::math::DVec3;
+use crate::scene::Scene;
+use crate::settings::RenderSettings;
+
+/// Text-chunk keywords. Part of the file format: never rename them.
+pub const KEY_VERSION: &str = "glint:version";
+pub const KEY_SCENE_PATH: &str = "glint:scene-path";
+pub const KEY_SCENE_SHA256: &str = "glint:scene-sha256";
+pub const KEY_SCENE: &str = "glint:scene";
+pub const KEY_SETTINGS: &str = "glint:settings";
+/// The private chunk holding the scene text (ancillary, private,
+/// safe to copy: lower, lower, upper, lower).
+pub const SCENE_CHUNK: [u8; 4] = *b"glSc";
+/// Largest scene text a record may hold once decompressed: far above any
+/// scene file (the largest SPD size, tetra_s8, is 5 MB), and a bound on
+/// what a crafted PNG can make glint allocate.
+pub const MAX_SCENE_TEXT: usize = 256 << 20;
+
+/// How an image was made: enough to make it again.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderRecord {
+    pub glint_version: String,
+    /// The scene file as it was named when loaded (anchors relative mesh paths).
+    pub scene_path: String,
+    pub scene_sha256: String,
+    pub scene_text: String,
+    pub settings: RecordedSettings,
+}
+
+/// The settings part of a record, stored as JSON.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RecordedSettings {
+    pub camera: RecordedCamera,
+    #[serde(flatten)]
+    pub render: RenderSettings,
+    pub octree_params: OctreeParams,
+    /// Octree overlay drawn down to this level, if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub overlay_depth: Option<u32>,
+    /// Lights and materials as edited in the viewer, replacing the scene
+    /// file's (absent when they are the file's own).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub edits: Option<SceneEdits>,
+    /// Exported from the viewer while a pass was still sweeping in: the
+    /// pixels are part old, part new, and a re-render gives the whole pass.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub partial: bool,
+}
+
+/// Lights and materials that replace a scene file's own.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SceneEdits {
+    pub lights: Vec<crate::material::Light>,
+    pub materials: Vec<crate::material::Material>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RecordedCamera {
+    pub eye: [f64; 3],
+    pub lookat: [f64; 3],
+    pub up: [f64; 3],
+    pub fov: f64,
+}
+
+impl From<&CameraSpec> for RecordedCamera {
+    fn from(c: &CameraSpec) -> Self {
+        Self {
+            eye: c.eye.to_array(),
+            lookat: c.lookat.to_array(),
+            up: c.up.to_array(),
+            fov: c.fov,
+        }
+    }
+}
+
+impl From<RecordedCamera> for CameraSpec {
+    fn from(c: RecordedCamera) -> Self {
+        Self {
+            eye: DVec3::from_array(c.eye),
+            lookat: DVec3::from_array(c.lookat),
+            up: DVec3::from_array(c.up),
+            fov: c.fov,
+        }
+    }
+}
+
+impl RenderRecord {
+    /// The record of rendering `scene` (named `scene_path`) from `camera`
+    /// with `settings`.
+    pub fn new(
+        scene: &Scene,
+        scene_path: &str,
+        camera: &CameraSpec,
+        settings: RenderSettings,
+    ) -> Self {
+        Self {
+            glint_version: env!("CARGO_PKG_VERSION").to_string(),
+            scene_path: scene_path.to_string(),
+            scene_sha256: sha256_hex(scene.source_text.as_bytes()),
+            scene_text: scene.source_text.to_string(),
+            settings: RecordedSettings {
+                camera: camera.into(),
+                render: settings,
+                octree_params: scene.octree_params,
+                overlay_depth: None,
+                edits: None,
+                partial: false,
+            },
+        }
+    }
+}
+
+/// The limits scene files and the command line enforce
+/// ([`crate::limits`]), applied to a record (a PNG is user input like any
+/// other).
+pub(super) fn validate(s: &RecordedSettings) -> Result<(), String> {
+    let name = |e: crate::limits::LimitError| e.to_string();
+    s.render.check().map_err(name)?;
+    s.octree_params.check().map_err(name)?;
+    if let Some(d) = s.overlay_depth
+        && d > crate::limits::MAX_OCTREE_DEPTH
+    {
+        return Err(name(crate::limits::LimitError::OverlayDepth(d)));
+    }
+    if let Some(e) = &s.edits {
+        // The ranges scene files are held to (scenes/README.md).
+        for (i, l) in e.lights.iter().enumerate() {
+            l.validate().map_err(|m| format!("light {i}: {m}"))?;
+        }
+        for m in &e.materials {
+            m.validate()
+                .map_err(|e| format!("material `{}`: {e}", m.name))?;
+        }
+    }
+    Ok(())
+}
+
+/// SHA-256 of `bytes` as 64 lowercase hex digits (FIPS 180-4, `sha2`).
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    use sha2::Digest;
+    format!("{:x}", sha2::Sha256::digest(bytes))
+}

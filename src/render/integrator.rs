@@ -1,0 +1,241 @@
+//! Whitted's integrator: the colour seen along one ray. At a hit, the local
+//! term (ambient plus each visible light's Lambert and Phong terms, with
+//! its shadow ray) and the secondary rays (refraction, then the mirror
+//! ray), each traced recursively to the depth limit (Whitted 1980).
+
+use crate::math::{Color, DVec3, Ray, offset_ray_origin, reflect, refract};
+use crate::ray_tree::{HitRecord, RayKind, RayRecorder, ShadowRecord, ShadowVerdict};
+use crate::settings::Protocol;
+use crate::shapes::PreparedRay;
+use crate::stats::{Counter, RayCounts};
+
+use super::renderer::Renderer;
+
+/// A hit resolved for shading: where, which way the surface faces, and
+/// with what material.
+struct ShadingPoint {
+    point: DVec3,
+    /// The geometric normal turned towards the incoming ray.
+    facing: DVec3,
+    /// The shading normal on the same side as `facing`.
+    normal: DVec3,
+    /// Whether the ray meets the surface from outside.
+    entering: bool,
+    material: u32,
+}
+
+impl Renderer<'_> {
+    /// Colour seen along `ray`, which is at recursion `depth` (eye ray = 1).
+    pub(super) fn trace<C: Counter, R: RayRecorder>(
+        &self,
+        ray: &Ray,
+        depth: u32,
+        counter: &mut C,
+        rays: &mut RayCounts,
+        rec: &mut R,
+    ) -> Color {
+        let Some(at) = self.shading_point(ray, counter, rec) else {
+            let background = self.background;
+            rec.local(background);
+            rec.finish(background);
+            return background;
+        };
+        if depth == 1 {
+            rays.primary_hits += 1;
+        }
+        let mut color = self.direct_light(ray, &at, counter, rays, rec);
+        rec.local(color);
+        if depth < self.settings.max_depth {
+            self.secondary_rays(ray, &at, depth, &mut color, counter, rays, rec);
+        }
+        rec.finish(color);
+        color
+    }
+
+    /// The nearest hit along `ray`, resolved for shading (`None`: the ray
+    /// leaves the scene).
+    fn shading_point<C: Counter, R: RayRecorder>(
+        &self,
+        ray: &Ray,
+        counter: &mut C,
+        rec: &mut R,
+    ) -> Option<ShadingPoint> {
+        let hit = self.closest(&PreparedRay::new(*ray), counter)?;
+        let scene = self.scene;
+        let shape = &scene.shapes[hit.shape as usize];
+        let surface = shape.surface(ray, &hit.hit, &scene.vertex_normals);
+        let material = scene.shape_materials[hit.shape as usize];
+        let entering = ray.dir.dot(surface.geometric_normal) < 0.0;
+        // Normals facing the incoming ray: glint's surfaces are two-sided.
+        let facing = if entering {
+            surface.geometric_normal
+        } else {
+            -surface.geometric_normal
+        };
+        let mut normal = if surface.shading_normal.dot(facing) < 0.0 {
+            -surface.shading_normal
+        } else {
+            surface.shading_normal
+        };
+        if !normal.is_finite() {
+            normal = facing;
+        }
+        let point = surface.point;
+        rec.material(material);
+        rec.hit(|| HitRecord {
+            object: hit.shape,
+            kind: shape.kind(),
+            material: self.materials[material as usize].name.clone(),
+            distance: hit.hit.t,
+            point: point.to_array(),
+            normal: normal.to_array(),
+            entering,
+        });
+        Some(ShadingPoint {
+            point,
+            facing,
+            normal,
+            entering,
+            material,
+        })
+    }
+
+    /// The local term at `at`: ambient light plus, for every light the
+    /// surface faces and its shadow ray reaches, Lambert's diffuse and
+    /// Phong's specular term, dimmed by what the shadow ray passed through.
+    fn direct_light<C: Counter, R: RayRecorder>(
+        &self,
+        ray: &Ray,
+        at: &ShadingPoint,
+        counter: &mut C,
+        rays: &mut RayCounts,
+        rec: &mut R,
+    ) -> Color {
+        let scene = self.scene;
+        let material = &self.materials[at.material as usize];
+        let n = at.normal;
+        let view = -ray.dir;
+        let mut color = material.ka * scene.image.ambient * material.color;
+        let shadow_origin = offset_ray_origin(at.point, at.facing, self.floor_scale);
+        for (index, light) in scene.lights.iter().enumerate() {
+            let verdict = |verdict, transmittance, color: Color| ShadowRecord {
+                light: index,
+                verdict,
+                transmittance,
+                color: color.to_array(),
+            };
+            let to_light = light.position - shadow_origin;
+            let distance = to_light.length();
+            if !(distance > 0.0) {
+                rec.light(index, false);
+                rec.shadow(|| verdict(ShadowVerdict::FacesAway, 0.0, Color::ZERO));
+                continue;
+            }
+            let l = to_light / distance;
+            let n_dot_l = n.dot(l);
+            // A surface facing away from the light gets neither light nor a
+            // shadow ray. glint asks both normals: an interpolated normal can
+            // face the light where the surface itself does not. The SPD
+            // asks the shading normal alone (its published shadow counts on
+            // the smooth-shaded teapot match only that way).
+            let faces_away = match self.settings.protocol {
+                Protocol::Glint => n_dot_l <= 0.0 || at.facing.dot(l) <= 0.0,
+                Protocol::Spd => n_dot_l <= 0.0,
+            };
+            if faces_away {
+                rec.light(index, false);
+                rec.shadow(|| verdict(ShadowVerdict::FacesAway, 0.0, Color::ZERO));
+                continue;
+            }
+            let pass = if self.settings.shadows {
+                rays.shadow += 1;
+                let shadow = PreparedRay::new(Ray::new(shadow_origin, l));
+                self.transmittance(&shadow, distance, counter)
+            } else {
+                1.0
+            };
+            rec.light(index, pass > 0.0);
+            if pass == 0.0 {
+                rec.shadow(|| verdict(ShadowVerdict::Blocked, 0.0, Color::ZERO));
+                continue;
+            }
+            let diffuse = material.kd * n_dot_l * material.color;
+            let r = 2.0 * n_dot_l * n - l;
+            let specular = material.ks * r.dot(view).max(0.0).powf(material.shininess);
+            let direct = (diffuse + DVec3::splat(specular)) * light.color * pass;
+            rec.shadow(|| {
+                let kind = if pass < 1.0 {
+                    ShadowVerdict::Attenuated
+                } else {
+                    ShadowVerdict::Lit
+                };
+                verdict(kind, pass, direct)
+            });
+            color += direct;
+        }
+        color
+    }
+
+    /// Adds what the refracted and the mirror ray from `at` see, each
+    /// weighted by the material, to `color`.
+    #[allow(clippy::too_many_arguments)]
+    fn secondary_rays<C: Counter, R: RayRecorder>(
+        &self,
+        ray: &Ray,
+        at: &ShadingPoint,
+        depth: u32,
+        color: &mut Color,
+        counter: &mut C,
+        rays: &mut RayCounts,
+        rec: &mut R,
+    ) {
+        let material = &self.materials[at.material as usize];
+        let (p, n, facing) = (at.point, at.normal, at.facing);
+        let mut reflect_weight = material.reflectivity;
+        if material.transparency > 0.0 {
+            let eta = if at.entering {
+                1.0 / material.ior
+            } else {
+                material.ior
+            };
+            match refract(ray.dir, n, eta) {
+                Some(dir) => {
+                    rays.refraction += 1;
+                    let origin = offset_ray_origin(p, -facing, self.floor_scale);
+                    let child_ray = Ray::new(origin, dir);
+                    let weight = material.transparency;
+                    let mut child = rec.child(RayKind::Refraction, &child_ray, depth + 1, weight);
+                    let seen = self.trace(&child_ray, depth + 1, counter, rays, &mut child);
+                    rec.attach(child, seen);
+                    *color += weight * seen;
+                }
+                // Total internal reflection: the transmitted share is reflected.
+                None => {
+                    rays.total_internal_reflections += 1;
+                    reflect_weight += material.transparency;
+                }
+            }
+        }
+        // The SPD counts a reflection ray from every reflective or
+        // transmitting surface, even one whose weight is zero.
+        let spawn_reflection = match self.settings.protocol {
+            Protocol::Glint => reflect_weight > 0.0,
+            Protocol::Spd => material.reflectivity > 0.0 || material.transparency > 0.0,
+        };
+        if spawn_reflection {
+            rays.reflection += 1;
+            let mut dir = reflect(ray.dir, n);
+            // An interpolated normal can send the mirror ray below the
+            // surface; fall back to the geometric mirror direction.
+            if dir.dot(facing) <= 0.0 {
+                dir = reflect(ray.dir, facing);
+            }
+            let origin = offset_ray_origin(p, facing, self.floor_scale);
+            let child_ray = Ray::new(origin, dir.normalize());
+            let mut child = rec.child(RayKind::Reflection, &child_ray, depth + 1, reflect_weight);
+            let seen = self.trace(&child_ray, depth + 1, counter, rays, &mut child);
+            rec.attach(child, seen);
+            *color += reflect_weight * seen;
+        }
+    }
+}

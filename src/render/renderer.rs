@@ -1,0 +1,226 @@
+//! A scene prepared for rendering with fixed settings: the camera built,
+//! materials in the convention the render shades in, which shapes are
+//! one-sided or transparent, and the ray queries (octree or brute force)
+//! the integrator asks.
+
+use crate::accel::{
+    ClosestHit, Octree, Primitives, ShadowCrossings, closest_brute_force, occlusion_brute_force,
+};
+use crate::camera::{Camera, CameraError, CameraSpec, sample_offsets};
+use crate::limits::LimitError;
+use crate::material::Material;
+use crate::math::Color;
+use crate::ray_tree::{RayKind, RayNode};
+use crate::scene::Scene;
+use crate::settings::{RenderSettings, Sides, ViewMode};
+use crate::shapes::PreparedRay;
+use crate::stats::{Counter, NoCounts, RayCounts};
+
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    #[error(transparent)]
+    Camera(#[from] CameraError),
+    #[error(transparent)]
+    Limit(#[from] LimitError),
+    #[error(
+        "a {width}x{height} render needs about {need} MiB of memory, more than the {limit} MiB \
+         this machine has available: choose a smaller image",
+        need = needed / (1 << 20),
+        limit = available / (1 << 20)
+    )]
+    OutOfMemory {
+        width: u32,
+        height: u32,
+        needed: u64,
+        available: u64,
+    },
+}
+
+thread_local! {
+    /// A shadow ray's crossings, kept per thread: the array is set up once,
+    /// not for every ray.
+    static SHADOW_CROSSINGS: std::cell::RefCell<ShadowCrossings> =
+        std::cell::RefCell::new(ShadowCrossings::default());
+}
+
+/// Crossings of one material closer than this, relative to the scene's
+/// magnitude, are one surface: far above the rounding of hit distances,
+/// far below any thickness a scene models.
+const SAME_SURFACE_RELATIVE: f64 = 1e-9;
+
+/// A scene prepared for rendering with fixed settings.
+pub struct Renderer<'a> {
+    pub(super) scene: &'a Scene,
+    octree: &'a Octree,
+    pub(super) settings: RenderSettings,
+    pub(super) camera: Camera,
+    /// Where in a pixel the rays of the full grid pass (the aa-need view
+    /// compares one sample with 16 whatever `settings.samples` says).
+    pub(super) grid: Vec<(f64, f64)>,
+    is_transparent: Vec<bool>,
+    /// Per shape: seen from outside only ([`Sides::One`]); empty otherwise.
+    one_sided: Vec<bool>,
+    /// The scene's materials and background as this render shades them
+    /// (decoded into linear light for a linear render of display values).
+    pub(super) materials: Vec<Material>,
+    pub(super) background: Color,
+    /// Magnitude of the scene's surfaces and the eye: the floor of ray offsets.
+    pub(super) floor_scale: f64,
+}
+
+impl<'a> Renderer<'a> {
+    pub fn new(
+        scene: &'a Scene,
+        octree: &'a Octree,
+        settings: RenderSettings,
+    ) -> Result<Self, RenderError> {
+        Self::with_camera(scene, octree, settings, &scene.camera)
+    }
+
+    /// Like [`Renderer::new`], seen from `camera` instead of the scene's own
+    /// (the viewer moves the camera without touching the scene).
+    pub fn with_camera(
+        scene: &'a Scene,
+        octree: &'a Octree,
+        settings: RenderSettings,
+        camera: &CameraSpec,
+    ) -> Result<Self, RenderError> {
+        settings.check()?;
+        let camera = Camera::new(camera, settings.width, settings.height)?;
+        let is_transparent: Vec<bool> = scene
+            .shape_materials
+            .iter()
+            .map(|&m| scene.materials[m as usize].transparency > 0.0)
+            .collect();
+        let one_sided = match settings.sides {
+            Sides::Two => Vec::new(),
+            Sides::One => scene
+                .shapes
+                .iter()
+                .zip(&is_transparent)
+                .map(|(shape, &transparent)| !transparent && !shape.has_vertex_normals())
+                .collect(),
+        };
+        let shade = |c| settings.colors.shading_color(scene.color_values, c);
+        let materials = scene
+            .materials
+            .iter()
+            .map(|m| Material {
+                color: shade(m.color),
+                ..m.clone()
+            })
+            .collect();
+        Ok(Self {
+            scene,
+            octree,
+            settings,
+            camera,
+            grid: sample_offsets(if settings.view == ViewMode::AaNeed {
+                16
+            } else {
+                settings.samples
+            }),
+            is_transparent,
+            one_sided,
+            materials,
+            background: shade(scene.image.background),
+            floor_scale: scene
+                .geometry_bounds()
+                .grow(camera.eye)
+                .max_abs()
+                .max(f64::MIN_POSITIVE),
+        })
+    }
+
+    pub fn settings(&self) -> &RenderSettings {
+        &self.settings
+    }
+
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    fn primitives(&self) -> Primitives<'_> {
+        Primitives {
+            shapes: &self.scene.shapes,
+            one_sided: &self.one_sided,
+            transparent: &self.is_transparent,
+        }
+    }
+
+    pub(super) fn closest<C: Counter>(
+        &self,
+        ray: &PreparedRay,
+        counter: &mut C,
+    ) -> Option<ClosestHit> {
+        let prims = self.primitives();
+        if self.settings.use_octree {
+            self.octree.closest(&prims, ray, f64::INFINITY, counter)
+        } else {
+            closest_brute_force(&prims, ray, f64::INFINITY, counter)
+        }
+    }
+
+    /// Fraction of light passing along the shadow ray to a light `distance`
+    /// away. Every surface crossed multiplies it by its material's
+    /// transparency (entering and leaving a glass sphere or a closed glass
+    /// mesh: T twice), whatever kind of shape it is; crossings of the same
+    /// material at the same place count once (coincident triangles, a ray
+    /// through a mesh's shared edge, two glass bodies touching: no
+    /// interface), and any opaque surface blocks the light.
+    pub(super) fn transmittance<C: Counter>(
+        &self,
+        ray: &PreparedRay,
+        distance: f64,
+        counter: &mut C,
+    ) -> f64 {
+        SHADOW_CROSSINGS.with_borrow_mut(|found| {
+            let prims = self.primitives();
+            if self.settings.use_octree {
+                self.octree.occlusion(&prims, ray, distance, found, counter);
+            } else {
+                occlusion_brute_force(&prims, ray, distance, found, counter);
+            }
+            self.pass_through(found)
+        })
+    }
+
+    /// The light a shadow ray's crossings let through.
+    fn pass_through(&self, found: &ShadowCrossings) -> f64 {
+        if found.is_blocked() {
+            return 0.0;
+        }
+        // Crossings come sorted by distance, so the product is the same
+        // whichever order they were found in.
+        let same_place = SAME_SURFACE_RELATIVE * self.floor_scale;
+        let mut pass = 1.0;
+        let mut previous: Option<(f64, u32)> = None;
+        for &(t, shape) in found.transparent() {
+            let material = self.scene.shape_materials[shape as usize];
+            let repeat = previous.is_some_and(|(pt, pm)| pm == material && t - pt <= same_place);
+            if !repeat {
+                pass *= self.materials[material as usize].transparency;
+            }
+            previous = Some((t, material));
+        }
+        pass
+    }
+
+    /// The tree of rays the centre ray of pixel `(i, j)` spawns (under the
+    /// SPD protocol, its top-left corner ray), with what each hit and
+    /// contributed. Its root colour is the pixel's value at 1 sample per
+    /// pixel in the shaded view.
+    pub fn ray_tree(&self, i: u32, j: u32) -> RayNode {
+        // The SPD protocol has no centre ray: its top-left corner ray.
+        let offset = if self.settings.corner_rays() {
+            0.0
+        } else {
+            0.5
+        };
+        let ray = self.camera.ray(i, j, offset, offset);
+        let mut root = RayNode::new(RayKind::Eye, &ray, 1, 1.0);
+        let mut rays = RayCounts::default();
+        self.trace(&ray, 1, &mut NoCounts, &mut rays, &mut root);
+        root
+    }
+}

@@ -1,0 +1,219 @@
+//! From eye rays to pixels: a sample is the view's value for one eye ray
+//! (a shaded colour, a normal, a distance or the work it took), a pixel
+//! the mean of its samples; a tile job fills one tile of a pass.
+
+use crate::math::{DVec3, Ray};
+use crate::ray_tree::{NoRecord, RayRecorder};
+use crate::settings::ViewMode;
+use crate::shapes::PreparedRay;
+use crate::stats::{Counter, NoCounts, RayCounts, RenderCounts, WorkCounts};
+
+use super::adaptive::Signature;
+use super::renderer::Renderer;
+use super::tiles::Tile;
+
+/// What one tile of a pass computes.
+#[derive(Clone, Copy)]
+pub(super) enum TileJob<'a> {
+    /// One ray through each pixel's centre; with `signatures`, what each
+    /// ray met is kept for adaptive anti-aliasing.
+    Centre { signatures: bool },
+    /// The full grid in every pixel.
+    Grid,
+    /// The full grid where `mask` (frame-sized, row-major) marks the pixel,
+    /// the one-sample value (`first`, frame-sized) elsewhere.
+    Refine {
+        first: &'a [DVec3],
+        mask: &'a [bool],
+    },
+    /// The SPD protocol's corner rays: the tile is in corner coordinates
+    /// (an image of `w x h` pixels has `(w + 1) x (h + 1)` corners), and
+    /// each value is one corner's sample.
+    Corners,
+}
+
+/// A finished tile: its pixels row-major, the signatures of a centre pass
+/// that keeps them, and what it counted.
+pub(super) struct TileOutput {
+    pub values: Vec<DVec3>,
+    pub signatures: Vec<u64>,
+    pub counts: RenderCounts,
+}
+
+impl Renderer<'_> {
+    /// Runs `job` over `tile`, counting Havran's work measures when
+    /// `count_work` (tracing is generic over the counter, so the other
+    /// case costs nothing).
+    pub(super) fn run_tile(&self, job: TileJob, tile: Tile, count_work: bool) -> TileOutput {
+        let mut out = TileOutput {
+            values: Vec::with_capacity(tile.pixels()),
+            signatures: Vec::new(),
+            counts: RenderCounts::default(),
+        };
+        if count_work {
+            let mut work = WorkCounts::default();
+            self.fill_tile(job, tile, &mut work, &mut out);
+            out.counts.work = work;
+        } else {
+            self.fill_tile(job, tile, &mut NoCounts, &mut out);
+        }
+        out
+    }
+
+    fn fill_tile<C: Counter>(
+        &self,
+        job: TileJob,
+        tile: Tile,
+        counter: &mut C,
+        out: &mut TileOutput,
+    ) {
+        let width = self.settings.width;
+        for (i, j) in tile.coordinates() {
+            let value = match job {
+                TileJob::Centre { signatures } => {
+                    let ray = self.camera.ray(i, j, 0.5, 0.5);
+                    let mut pixel = PixelSum::default();
+                    if signatures {
+                        let mut signature = Signature::default();
+                        pixel.add(self.sample_recorded(
+                            &ray,
+                            counter,
+                            &mut out.counts,
+                            &mut signature,
+                        ));
+                        out.signatures.push(signature.value);
+                    } else {
+                        pixel.add(self.sample(&ray, counter, &mut out.counts));
+                    }
+                    pixel.value(self.settings.view, true)
+                }
+                TileJob::Grid => self.grid_pixel(i, j, counter, &mut out.counts),
+                TileJob::Corners => {
+                    self.sample(&self.camera.ray(i, j, 0.0, 0.0), counter, &mut out.counts)
+                }
+                TileJob::Refine { first, mask } => {
+                    let at = (j * width + i) as usize;
+                    if mask[at] {
+                        out.counts.refined_pixels += 1;
+                        self.grid_pixel(i, j, counter, &mut out.counts)
+                    } else {
+                        first[at]
+                    }
+                }
+            };
+            out.values.push(value);
+        }
+    }
+
+    /// Value of pixel `(i, j)` from its full grid of samples.
+    fn grid_pixel<C: Counter>(
+        &self,
+        i: u32,
+        j: u32,
+        counter: &mut C,
+        counts: &mut RenderCounts,
+    ) -> DVec3 {
+        let mut pixel = PixelSum::default();
+        for &(dx, dy) in &self.grid {
+            pixel.add(self.sample(&self.camera.ray(i, j, dx, dy), counter, counts));
+        }
+        pixel.value(self.settings.view, true)
+    }
+
+    /// The view's value for one eye ray (shaded colour, normal, distance
+    /// or work), with its rays and work counted; non-finite values are
+    /// counted and shown black.
+    pub(super) fn sample<C: Counter>(
+        &self,
+        ray: &Ray,
+        counter: &mut C,
+        counts: &mut RenderCounts,
+    ) -> DVec3 {
+        self.sample_recorded(ray, counter, counts, &mut NoRecord)
+    }
+
+    /// [`Renderer::sample`], telling `rec` what the ray met.
+    fn sample_recorded<C: Counter, R: RayRecorder>(
+        &self,
+        ray: &Ray,
+        counter: &mut C,
+        counts: &mut RenderCounts,
+        rec: &mut R,
+    ) -> DVec3 {
+        counts.rays.primary += 1;
+        let view = self.settings.view;
+        let value = if view.is_cost() {
+            // Count this ray's work on its own, then pass it on.
+            let mut work = WorkCounts::default();
+            self.trace(ray, 1, &mut work, &mut counts.rays, rec);
+            counter.add_work(&work);
+            DVec3::new(
+                work.intersection_tests as f64,
+                work.traversal_steps as f64,
+                work.leaves_visited as f64,
+            )
+        } else if view.traces_shading() {
+            self.trace(ray, 1, counter, &mut counts.rays, rec)
+        } else {
+            self.inspect(ray, counter, &mut counts.rays)
+        };
+        if value.is_finite() {
+            value
+        } else {
+            counts.nonfinite_samples += 1;
+            DVec3::ZERO
+        }
+    }
+
+    /// One sample of a non-shaded view for the eye ray `ray`.
+    fn inspect<C: Counter>(&self, ray: &Ray, counter: &mut C, rays: &mut RayCounts) -> DVec3 {
+        let prepared = PreparedRay::new(*ray);
+        let Some(hit) = self.closest(&prepared, counter) else {
+            return DVec3::ZERO;
+        };
+        rays.primary_hits += 1;
+        match self.settings.view {
+            ViewMode::Normals => {
+                let s = self.scene.shapes[hit.shape as usize].surface(
+                    ray,
+                    &hit.hit,
+                    &self.scene.vertex_normals,
+                );
+                let n = s.geometric_normal;
+                let facing = if n.dot(ray.dir) > 0.0 { -n } else { n };
+                (facing + DVec3::ONE) * 0.5
+            }
+            _ => DVec3::new(hit.hit.t, 1.0, 0.0),
+        }
+    }
+}
+
+/// A pixel's samples as they arrive: their sum and their number.
+#[derive(Clone, Copy, Default)]
+pub(super) struct PixelSum {
+    sum: DVec3,
+    n: u32,
+}
+
+impl PixelSum {
+    #[inline]
+    pub(super) fn add(&mut self, sample: DVec3) {
+        self.sum += sample;
+        self.n += 1;
+    }
+
+    /// The pixel: the samples' mean; for the depth view the mean distance
+    /// of those that hit (`x` sums distances, `y` hits) and the share that
+    /// hit; for the cost views their sum (`cost_sum`) or mean.
+    pub(super) fn value(&self, view: ViewMode, cost_sum: bool) -> DVec3 {
+        let n = self.n.max(1) as f64;
+        match view {
+            ViewMode::Depth if self.sum.y > 0.0 => {
+                DVec3::new(self.sum.x / self.sum.y, self.sum.y / n, 0.0)
+            }
+            ViewMode::Depth => DVec3::ZERO,
+            ViewMode::Cost | ViewMode::CostSteps if cost_sum => self.sum,
+            _ => self.sum / n,
+        }
+    }
+}
