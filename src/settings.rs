@@ -147,7 +147,7 @@ pub struct RenderSettings {
     #[serde(default)]
     pub sides: Sides,
     /// With `samples > 1`: trace every pixel's centre, then the full grid
-    /// only where the picture shows an edge (see [`crate::adaptive`]).
+    /// only where the picture shows an edge (see [`crate::render::adaptive`]).
     #[serde(default)]
     pub adaptive: bool,
     /// Cast shadow rays (off only in the viewer's previews while moving:

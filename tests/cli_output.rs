@@ -4,7 +4,7 @@
 mod common;
 
 use std::os::unix::fs::FileTypeExt;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 const PNG_SIGNATURE: &[u8] = b"\x89PNG\r\n\x1a\n";
@@ -20,14 +20,6 @@ fn scene() -> String {
     common::repo_path("scenes/sphere.toml")
         .to_string_lossy()
         .into_owned()
-}
-
-/// A fresh directory for one test.
-fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("glint-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
 }
 
 fn small(out: &Path) -> Vec<String> {
@@ -54,7 +46,8 @@ fn stderr(o: &Output) -> String {
 
 #[test]
 fn a_symbolic_link_is_written_through_to_its_target() {
-    let d = dir("link");
+    let tmp = common::temp_dir();
+    let d = tmp.path();
     let target = d.join("target.png");
     std::fs::write(&target, b"old").unwrap();
     let link = d.join("link.png");
@@ -83,17 +76,17 @@ fn a_symbolic_link_is_written_through_to_its_target() {
             .starts_with(PNG_SIGNATURE)
     );
     // No temporary file is left behind.
-    let names: Vec<String> = std::fs::read_dir(&d)
+    let names: Vec<String> = std::fs::read_dir(d)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .collect();
     assert!(names.iter().all(|n| !n.contains(".tmp")), "{names:?}");
-    std::fs::remove_dir_all(&d).unwrap();
 }
 
 #[test]
 fn a_fifo_is_written_not_replaced() {
-    let d = dir("fifo");
+    let tmp = common::temp_dir();
+    let d = tmp.path();
     let fifo = d.join("pipe");
     let status = Command::new("mkfifo").arg(&fifo).status().unwrap();
     assert!(status.success());
@@ -117,14 +110,14 @@ fn a_fifo_is_written_not_replaced() {
         std::fs::metadata(&fifo).unwrap().file_type().is_fifo(),
         "still a FIFO"
     );
-    std::fs::remove_dir_all(&d).unwrap();
 }
 
 #[test]
 fn dash_writes_the_png_to_standard_output() {
-    let d = dir("stdout");
+    let tmp = common::temp_dir();
+    let d = tmp.path();
     let o = Command::new(env!("CARGO_BIN_EXE_glint"))
-        .current_dir(&d)
+        .current_dir(d)
         .args([
             "render",
             &scene(),
@@ -146,12 +139,12 @@ fn dash_writes_the_png_to_standard_output() {
     let o = glint(&["render", &scene(), "-o", "-", "--stats"]);
     assert!(!o.status.success());
     assert!(stderr(&o).contains("standard output"), "{}", stderr(&o));
-    std::fs::remove_dir_all(&d).unwrap();
 }
 
 #[test]
 fn other_extensions_and_the_input_scene_are_refused() {
-    let d = dir("refuse");
+    let tmp = common::temp_dir();
+    let d = tmp.path();
     for name in ["out.jpg", "out", "scene.toml"] {
         let out = d.join(name);
         let o = run(&small(&out));
@@ -181,12 +174,12 @@ fn other_extensions_and_the_input_scene_are_refused() {
         stderr(&o)
     );
     assert_eq!(std::fs::read(&first).unwrap(), before, "left untouched");
-    std::fs::remove_dir_all(&d).unwrap();
 }
 
 #[test]
 fn success_is_one_line_on_stderr_unless_quiet() {
-    let d = dir("quiet");
+    let tmp = common::temp_dir();
+    let d = tmp.path();
     let out = d.join("a.png");
     let o = run(&small(&out));
     let text = stderr(&o);
@@ -199,12 +192,12 @@ fn success_is_one_line_on_stderr_unless_quiet() {
     quiet.push("--quiet".into());
     let o = run(&quiet);
     assert!(o.status.success() && o.stderr.is_empty(), "{}", stderr(&o));
-    std::fs::remove_dir_all(&d).unwrap();
 }
 
 #[test]
 fn trace_pixel_with_an_output_writes_both() {
-    let d = dir("trace");
+    let tmp = common::temp_dir();
+    let d = tmp.path();
     let out = d.join("a.png");
     let mut args = small(&out);
     args.extend(["--trace-pixel".into(), "8,6".into()]);
@@ -213,7 +206,6 @@ fn trace_pixel_with_an_output_writes_both() {
     let tree: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(tree["pixel"], serde_json::json!([8, 6]));
     assert!(std::fs::read(&out).unwrap().starts_with(PNG_SIGNATURE));
-    std::fs::remove_dir_all(&d).unwrap();
 }
 
 #[test]

@@ -387,8 +387,8 @@ proptest! {
 
 #[test]
 fn malformed_inputs_are_clear_errors() {
-    let dir = std::env::temp_dir().join(format!("glint-bad-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = common::temp_dir();
+    let dir = tmp.path();
     let cases: &[(&str, &[u8], &str)] = &[
         ("missing.toml", b"", "cannot read scene file"),
         ("binary.toml", b"\xff\xfe\x00camera", "is not UTF-8"),
@@ -412,7 +412,6 @@ fn malformed_inputs_are_clear_errors() {
             "{file}: the message names the file: {err}"
         );
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// A scene with every key glint's TOML has (a mesh too), for the
@@ -579,8 +578,8 @@ fn loads_cleanly_or_renders_finite(text: &str, name: &std::path::Path, what: &st
 /// refusal names its place in the file.
 #[test]
 fn extreme_values_in_every_key_are_refused_or_render_finite() {
-    let dir = std::env::temp_dir().join(format!("glint-extremes-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = common::temp_dir();
+    let dir = tmp.path();
     std::fs::write(
         dir.join("quad.obj"),
         "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n",
@@ -619,5 +618,4 @@ fn extreme_values_in_every_key_are_refused_or_render_finite() {
     eprintln!(
         "extreme values: {loaded} scenes loaded and rendered finite, {refused} refused with a place"
     );
-    std::fs::remove_dir_all(&dir).unwrap();
 }

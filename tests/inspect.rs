@@ -3,7 +3,6 @@
 
 mod common;
 
-use std::path::Path;
 use std::process::Command;
 
 use glint::accel::Octree;
@@ -12,7 +11,7 @@ use glint::math::DVec3;
 use glint::metrics::image_error;
 use glint::ray_tree::{RayKind, RayNode};
 use glint::render::Renderer;
-use glint::scene::{FileSystem, Scene};
+use glint::scene::Scene;
 use glint::settings::{RenderSettings, ViewMode};
 
 /// A mirror sphere and a glass sphere over a floor, two lights.
@@ -74,10 +73,6 @@ material = "mirror"
 center = [-1.1, 1, -0.5]
 radius = 0.8
 "#;
-
-fn scene_from(text: &str) -> Scene {
-    glint::scene::load_str(text, Path::new("test.toml"), &FileSystem).unwrap()
-}
 
 fn settings(scene: &Scene, view: ViewMode, use_octree: bool) -> RenderSettings {
     RenderSettings {
@@ -156,7 +151,7 @@ fn check_sums(node: &RayNode, scene: &Scene) {
 
 #[test]
 fn ray_tree_of_a_glass_pixel_has_reflection_and_refraction_and_sums_to_the_pixel() {
-    let scene = scene_from(MIRROR_AND_GLASS);
+    let scene = common::scene_from(MIRROR_AND_GLASS, "test.toml");
     let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
     let s = settings(&scene, ViewMode::Shaded, true);
     let renderer = Renderer::new(&scene, &octree, s).unwrap();
@@ -199,7 +194,7 @@ fn cost_counts_one_test_per_primitive_without_the_octree_and_none_outside_it() {
         "[[objects]]\nkind = \"plane\"\nmaterial = \"floor\"\npoint = [0, 0, 0]\nnormal = [0, 1, 0]\n",
         "",
     );
-    let scene = scene_from(&text);
+    let scene = common::scene_from(&text, "test.toml");
     assert_eq!(scene.shapes.len(), 2);
     let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
     let corner = |use_octree| {
@@ -288,8 +283,8 @@ fn glint() -> Command {
 
 #[test]
 fn exports_record_how_they_were_made_and_render_again_identically() {
-    let dir = std::env::temp_dir().join(format!("glint-export-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = common::temp_dir();
+    let dir = tmp.path();
     let first = dir.join("first.png");
     let again = dir.join("again.png");
     let scene = common::repo_path("scenes/glass.toml");
@@ -347,7 +342,6 @@ fn exports_record_how_they_were_made_and_render_again_identically() {
             "{args:?}: {err}"
         );
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -382,8 +376,8 @@ fn trace_pixel_prints_the_tree_as_json() {
 fn records_outside_the_limits_are_refused() {
     let scene = common::load("scenes/sphere.toml");
     let settings = scene.render_settings();
-    let dir = std::env::temp_dir().join(format!("glint-bad-record-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = common::temp_dir();
+    let dir = tmp.path();
     let path = dir.join("bad.png");
     let base =
         glint::export::RenderRecord::new(&scene, "scenes/sphere.toml", &scene.camera, settings);
@@ -416,5 +410,4 @@ fn records_outside_the_limits_are_refused() {
     // An untouched record reads back equal.
     glint::export::save_rgb_png(&path, 1, 1, &[0, 0, 0], Some(&base)).unwrap();
     assert_eq!(glint::export::read_record(&path).unwrap(), base);
-    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -4,20 +4,12 @@
 
 mod common;
 
-use std::path::Path;
-
-use common::{render_with, repo_path};
+use common::{render_with, repo_path, scene_from};
 use glint::accel::{Octree, OctreeParams};
 use glint::camera::Camera;
 use glint::math::DVec3;
 use glint::render::Renderer;
-use glint::scene::Scene;
 use glint::settings::ViewMode;
-
-fn scene_from(text: &str, name: &str) -> Scene {
-    glint::scene::load_str(text, Path::new(name), &glint::scene::FileSystem)
-        .unwrap_or_else(|e| panic!("{e}"))
-}
 
 fn nff_with_polygon(eye: DVec3, vertices: &[DVec3], size: u32) -> String {
     let mut s = format!(
@@ -346,6 +338,21 @@ fn coincident_triangles_stop_splitting_instead_of_multiplying() {
         "{} references",
         stats.references
     );
+    // All 1,000 are hit at the same distance: the tie goes to the lowest
+    // index, whichever leaf the walk finds them in.
+    let prims = glint::accel::Primitives::opaque(&scene.shapes);
+    let ray = glint::shapes::PreparedRay::new(glint::math::Ray::new(
+        DVec3::new(0.5, 1.0, 0.5),
+        -DVec3::Y,
+    ));
+    let hit = octree
+        .closest(&prims, &ray, f64::INFINITY, &mut glint::stats::NoCounts)
+        .unwrap();
+    assert_eq!(
+        (hit.shape, hit.hit.t),
+        (0, 1.0),
+        "ties go to the lowest index"
+    );
 }
 
 #[test]
@@ -555,8 +562,8 @@ fn records_of_large_scenes_keep_standard_text_chunks_small() {
         &scene.camera,
         settings,
     );
-    let dir = std::env::temp_dir().join(format!("glint-large-record-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = common::temp_dir();
+    let dir = tmp.path();
     let png = dir.join("gears.png");
     glint::export::save_png(&frame, &png, Some(&record)).unwrap();
     let bytes = std::fs::read(&png).unwrap();
@@ -577,5 +584,4 @@ fn records_of_large_scenes_keep_standard_text_chunks_small() {
     assert_eq!(read, record);
     // And a reader that does not know glint still decodes the image.
     assert_eq!(image::open(&png).unwrap().to_rgb8().dimensions(), (8, 8));
-    std::fs::remove_dir_all(&dir).unwrap();
 }

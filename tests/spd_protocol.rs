@@ -4,9 +4,7 @@
 
 mod common;
 
-use std::path::Path;
-
-use common::repo_path;
+use common::{repo_path, scene_from};
 use glint::accel::Octree;
 use glint::color::ColorConvention;
 use glint::math::DVec3;
@@ -14,11 +12,6 @@ use glint::ray_tree::{RayKind, RayNode};
 use glint::render::Renderer;
 use glint::scene::Scene;
 use glint::settings::{Protocol, RenderSettings, ViewMode};
-
-fn scene_from(text: &str, name: &str) -> Scene {
-    glint::scene::load_str(text, Path::new(name), &glint::scene::FileSystem)
-        .unwrap_or_else(|e| panic!("{e}"))
-}
 
 fn spd(scene: &Scene) -> RenderSettings {
     scene.render_settings().with_protocol(Protocol::Spd)
@@ -123,14 +116,9 @@ impl glint::render::PassWatch for BandCollector {
     fn shows_tiles(&self) -> bool {
         true
     }
-    fn tile_done(
-        &self,
-        _pass: &glint::render::PassInfo,
-        tile: &glint::render::tiles::Tile,
-        pixels: Option<&glint::render::TilePixels>,
-    ) {
-        let values = pixels.expect("pixels were asked for").values().to_vec();
-        self.bands.lock().unwrap().push((*tile, values));
+    fn tile_done(&self, _pass: &glint::render::PassInfo, done: &glint::render::FinishedTile) {
+        let values = done.values().expect("pixels were asked for").to_vec();
+        self.bands.lock().unwrap().push((done.tile, values));
     }
 }
 

@@ -105,10 +105,10 @@ fn export_writes_the_displayed_buffer() {
         h.state().worker().wait_finished(generation, WAIT),
         "the render finished"
     );
-    let path = std::env::temp_dir().join(format!("glint-export-{}.png", std::process::id()));
+    let tmp = common::temp_dir();
+    let path = tmp.path().join("export.png");
     h.state().export_to(&path).unwrap();
     let png = image::open(&path).unwrap().to_rgb8();
-    let _ = std::fs::remove_file(&path);
     let (w, hgt, rgba) = h
         .state()
         .worker()
@@ -369,8 +369,8 @@ fn clicking_in_inspect_mode_picks_the_pixel_and_its_ray_tree() {
 #[test]
 fn viewer_exports_render_again_identically_from_their_metadata() {
     use glint::settings::ViewMode;
-    let dir = std::env::temp_dir().join(format!("glint-viewer-export-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = common::temp_dir();
+    let dir = tmp.path();
     let (first, again) = (dir.join("first.png"), dir.join("again.png"));
     let mut h = harness(small_app());
     settle(&mut h);
@@ -420,7 +420,6 @@ fn viewer_exports_render_again_identically_from_their_metadata() {
         let (n, largest) = common::rerender_from_png(&first, &again);
         assert_eq!(n, 0, "{name}: {n} pixels differ (largest {largest})");
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

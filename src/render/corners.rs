@@ -13,7 +13,7 @@ use crate::frame::TileEncoder;
 use crate::math::DVec3;
 use crate::stats::RenderCounts;
 
-use super::passes::{PassInfo, PassWatch, TilePixels};
+use super::passes::{FinishedTile, PassInfo, PassWatch};
 use super::renderer::Renderer;
 use super::sampling::{PixelSum, TileJob};
 use super::tiles::{Tile, corner_bands};
@@ -93,13 +93,9 @@ impl Renderer<'_> {
                         width: w,
                         height: last_row - start,
                     };
-                    if shows {
-                        let values = self.pixels_from_corners(&corners, stride, w, tile.height);
-                        let pixels = TilePixels::new(&values, encoder);
-                        watch.tile_done(info, &tile, Some(&pixels));
-                    } else {
-                        watch.tile_done(info, &tile, None);
-                    }
+                    let values =
+                        shows.then(|| self.pixels_from_corners(&corners, stride, w, tile.height));
+                    watch.tile_done(info, &FinishedTile::new(tile, values.as_deref(), encoder));
                 }
                 Some((rows, out.counts))
             })

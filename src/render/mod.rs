@@ -18,8 +18,8 @@ pub mod tiles;
 mod renderer;
 
 pub use passes::{
-    FinishedPass, PassInfo, PassKind, PassOptions, PassSummary, PassWatch, RenderedFrame,
-    TilePixels,
+    FinishedPass, FinishedTile, PassInfo, PassKind, PassOptions, PassSummary, PassWatch,
+    RenderedFrame,
 };
 pub use renderer::{RenderError, Renderer};
 

@@ -87,27 +87,39 @@ impl PassInfo {
     }
 }
 
-/// A finished tile's pixels, and their display bytes on demand (depth and
-/// cost normalised by what the pass has seen so far; the finished pass's
-/// frame replaces them with the exact picture).
-pub struct TilePixels<'a> {
-    values: &'a [DVec3],
+/// A finished tile: where it lies in the image, and (when the watcher
+/// [shows tiles](PassWatch::shows_tiles)) its pixels and their display
+/// bytes on demand: depth and cost normalised by what the pass has seen so
+/// far, which the finished pass's frame replaces with the exact picture.
+pub struct FinishedTile<'a> {
+    pub tile: Tile,
+    values: Option<&'a [DVec3]>,
     encoder: &'a TileEncoder,
 }
 
-impl<'a> TilePixels<'a> {
-    pub(super) fn new(values: &'a [DVec3], encoder: &'a TileEncoder) -> Self {
-        Self { values, encoder }
+impl<'a> FinishedTile<'a> {
+    pub(super) fn new(tile: Tile, values: Option<&'a [DVec3]>, encoder: &'a TileEncoder) -> Self {
+        Self {
+            tile,
+            values,
+            encoder,
+        }
     }
 
     /// The tile's values, row-major, as its pass's frame holds them.
-    pub fn values(&self) -> &[DVec3] {
+    pub fn values(&self) -> Option<&[DVec3]> {
         self.values
     }
 
-    /// RGBA8, row-major, as the viewer shows the tile.
-    pub fn rgba(&self) -> Vec<u8> {
-        crate::frame::rgb_to_rgba(&self.encoder.rgb(self.values))
+    /// Paints the tile's display colours into `rgba`, an RGBA8 image
+    /// `width` pixels wide; `false` without pixels.
+    pub fn paint_rgba(&self, rgba: &mut [u8], width: u32) -> bool {
+        let Some(values) = self.values else {
+            return false;
+        };
+        let bytes = crate::frame::rgb_to_rgba(&self.encoder.rgb(values));
+        place_tile(rgba, width, &self.tile, &bytes, 4);
+        true
     }
 }
 
@@ -147,9 +159,8 @@ pub trait PassWatch: Sync {
         false
     }
     fn pass_started(&self, _pass: &PassInfo) {}
-    /// A tile (in image pixels) is done; its pixels when
-    /// [`PassWatch::shows_tiles`].
-    fn tile_done(&self, _pass: &PassInfo, _tile: &Tile, _pixels: Option<&TilePixels>) {}
+    /// A tile of the image is done.
+    fn tile_done(&self, _pass: &PassInfo, _tile: &FinishedTile) {}
     fn pass_done(&self, _pass: &FinishedPass) {}
 }
 
@@ -163,7 +174,7 @@ struct Progress<'a> {
 }
 
 impl PassWatch for Progress<'_> {
-    fn tile_done(&self, pass: &PassInfo, _tile: &Tile, _pixels: Option<&TilePixels>) {
+    fn tile_done(&self, pass: &PassInfo, _tile: &FinishedTile) {
         let n = self.done.fetch_add(1, Ordering::Relaxed) + 1;
         (self.report)(n, pass.frame_tiles);
     }
@@ -411,8 +422,8 @@ impl Renderer<'_> {
                     return None;
                 }
                 let out = self.run_tile(job, tile, count_work);
-                let pixels = shows.then(|| TilePixels::new(&out.values, encoder));
-                watch.tile_done(info, &tile, pixels.as_ref());
+                let values = shows.then_some(out.values.as_slice());
+                watch.tile_done(info, &FinishedTile::new(tile, values, encoder));
                 Some(out)
             })
             .collect();

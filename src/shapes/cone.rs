@@ -1,3 +1,6 @@
+//! NFF cones and cylinders (`c`): open truncated cones without caps, with
+//! the enclosing capsule the octree classifies them by.
+
 use super::hit::{Crossings, ShapeHit, Surface, unit_or_none};
 use crate::math::{Aabb, DVec3, Ray, solve_quadratic_half};
 

@@ -1,3 +1,6 @@
+//! Infinite planes: the one unbounded shape besides unclipped quadrics,
+//! tested for every ray outside the octree.
+
 use super::hit::{ShapeHit, Surface};
 use crate::math::{DVec3, Ray};
 

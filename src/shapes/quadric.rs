@@ -1,3 +1,7 @@
+//! General quadric surfaces, optionally clipped to a box: ellipsoids,
+//! cylinders, cones, hyperboloids and paraboloids from one implicit
+//! equation, evaluated in local coordinates and refined by a Newton step.
+
 use super::hit::{Crossings, ShapeHit, Surface, unit_or_none};
 use crate::math::{Aabb, DVec3, Ray, solve_quadratic_half};
 

@@ -1,3 +1,7 @@
+//! Spheres: the ray test in the numerically stable form of Haines et al.
+//! (*Ray Tracing Gems*, ch. 7), hit points re-projected onto the surface,
+//! and the exact sphere/box overlap the octree classifies with.
+
 use super::hit::{Crossings, ShapeHit, Surface, unit_or_none};
 use crate::math::{Aabb, DVec3, Ray};
 

@@ -1,3 +1,8 @@
+//! Triangles: the watertight ray test of Woop, Benthin & Wald (2013), in
+//! `f64`, so rays through shared edges and vertices never slip through a
+//! mesh; interpolated vertex normals for smooth meshes; and the exact
+//! triangle/box overlap (separating axes) the octree classifies with.
+
 use super::hit::{PreparedRay, ShapeHit, Surface, unit_or_none};
 use crate::math::{Aabb, DVec3};
 

@@ -9,13 +9,15 @@ use std::time::Instant;
 use egui::{Color32, Sense, TextureHandle, TextureOptions};
 
 use super::command::Command;
-use super::inspect::{Compare, CompareMode, DiffStats, InspectState, Inspection};
+use super::compare::{Compare, CompareMode, DiffStats};
+use super::inspect::InspectState;
 use super::panels::{Message, RenderInfo};
+use super::pixel::Inspection;
 use super::screenshot::Screenshot;
 use super::state::EditState;
 pub use super::state::{CompareSetting, SceneSource};
 use super::worker::{Job, Preview, Worker};
-use super::{budget, export, input, panels};
+use super::{budget, export, input, panels, timing};
 use crate::accel::Octree;
 use crate::camera::CameraSpec;
 use crate::scene::Scene;
@@ -282,7 +284,7 @@ impl GlintApp {
             .resizable(false)
             .exact_size(330.0)
             .show(ui, |ui| {
-                panels::timing_ui(&self.edit, &info, &self.inspect, ui)
+                timing::timing_ui(&self.edit, &info, &self.inspect, ui)
             });
         egui::CentralPanel::default_margins().show(ui, |ui| commands.extend(self.image_ui(ui)));
         self.apply(commands, &ctx);

@@ -7,13 +7,16 @@
 pub mod app;
 mod budget;
 pub mod command;
+pub mod compare;
 mod export;
 mod input;
 pub mod inspect;
 mod orbit;
 mod panels;
+pub mod pixel;
 mod screenshot;
 pub mod state;
+mod timing;
 pub mod worker;
 
 pub use app::{GlintApp, ViewerOptions};

@@ -15,9 +15,7 @@ use std::time::{Duration, Instant};
 use crate::accel::Octree;
 use crate::camera::CameraSpec;
 use crate::frame::{Frame, rgb_to_rgba};
-use crate::render::{
-    FinishedPass, PassInfo, PassOptions, PassWatch, Renderer, TilePixels, tiles::Tile,
-};
+use crate::render::{FinishedPass, FinishedTile, PassInfo, PassOptions, PassWatch, Renderer};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::stats::RayCounts;
@@ -450,13 +448,13 @@ impl PassWatch for Display<'_> {
         b.version += 1;
     }
 
-    fn tile_done(&self, pass: &PassInfo, tile: &Tile, pixels: Option<&TilePixels>) {
-        let Some(pixels) = pixels else { return };
-        let rgba = pixels.rgba();
+    fn tile_done(&self, pass: &PassInfo, tile: &FinishedTile) {
         {
             let mut b = self.buffer();
-            if b.generation == self.generation && b.width == pass.width {
-                crate::render::tiles::place_tile(&mut b.rgba, pass.width, tile, &rgba, 4);
+            if b.generation == self.generation
+                && b.width == pass.width
+                && tile.paint_rgba(&mut b.rgba, pass.width)
+            {
                 b.tiles_done = self.done.fetch_add(1, Ordering::Relaxed) + 1;
                 b.version += 1;
             }

@@ -13,6 +13,18 @@ pub fn repo_path(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
 }
 
+/// A scene from `text`; `name`'s extension picks the format and names it
+/// in errors.
+pub fn scene_from(text: &str, name: &str) -> Scene {
+    glint::scene::load_str(text, Path::new(name), &glint::scene::FileSystem)
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// A fresh directory, removed when the value is dropped.
+pub fn temp_dir() -> tempfile::TempDir {
+    tempfile::tempdir().unwrap()
+}
+
 pub fn load(rel: &str) -> Scene {
     let path = repo_path(rel);
     glint::scene::load(&path).unwrap_or_else(|e| panic!("{e}"))

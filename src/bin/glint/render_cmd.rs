@@ -7,8 +7,7 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use glint::accel::{Octree, OctreeStats};
 use glint::camera::CameraSpec;
-use glint::render::tiles::Tile;
-use glint::render::{PassInfo, PassOptions, PassWatch, RenderedFrame, Renderer, TilePixels};
+use glint::render::{FinishedTile, PassInfo, PassOptions, PassWatch, RenderedFrame, Renderer};
 use glint::settings::{Overrides, RenderSettings, ViewMode};
 use glint::stats::RayCounts;
 use serde::Serialize;
@@ -341,7 +340,7 @@ struct ProgressBar<'a> {
 }
 
 impl PassWatch for ProgressBar<'_> {
-    fn tile_done(&self, pass: &PassInfo, _tile: &Tile, _pixels: Option<&TilePixels>) {
+    fn tile_done(&self, pass: &PassInfo, _tile: &FinishedTile) {
         if let Some(b) = self.bar {
             b.set_length(pass.frame_tiles);
             b.inc(1);

@@ -1,0 +1,38 @@
+//! Octree over the bounded shapes of a scene.
+//!
+//! Build: breadth first, level by level, each node is split at its centre
+//! into eight octants; a shape is referenced from every cell its surface
+//! really touches (exact triangle/box and sphere/box tests). A node stays a
+//! leaf when it holds at most `leaf_size` references, reaches `max_depth`,
+//! or when a split would not separate its references: every non-empty
+//! child would hold all of them, or the children together would hold more
+//! than `max_duplication` times as many (the termination criterion Havran
+//! discusses for hierarchical subdivisions: splitting large overlapping
+//! objects only multiplies references). Optionally a surface-area cost
+//! estimate (MacDonald & Booth 1990) keeps a node as a leaf when splitting
+//! would not pay. A memory budget bounds the whole structure: once a split
+//! would exceed it, nodes stay leaves, which is always correct, only slower.
+//! Because the build goes level by level and decides in a fixed order, the
+//! budget is spent on the coarse levels first and the tree is the same for
+//! any number of threads.
+//!
+//! Traversal: front to back in the parametric manner of Revelles, Ureña &
+//! Lastra, "An Efficient Parametric Algorithm for Octree Traversal" (WSCG
+//! 2000): from the parameters at which the ray crosses a node's three
+//! mid-planes follows the sequence of children it passes through, without
+//! any point-in-box test. It runs iteratively on a small stack kept per
+//! thread (no allocation, no recursion); a node stores a mask of its
+//! non-empty children, which alone are stored and visited. Rays stop as
+//! soon as the best hit lies before the exit of the current leaf.
+
+mod build;
+mod node;
+mod params;
+mod tree;
+mod walk;
+
+pub use params::{DEFAULT_MEMORY_BUDGET_MIB, OctreeCell, OctreeError, OctreeParams, OctreeStats};
+pub use tree::Octree;
+
+#[cfg(test)]
+mod tests;

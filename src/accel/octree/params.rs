@@ -1,0 +1,123 @@
+//! What an octree is built with and what it reports: its parameters,
+//! Havran's statistics of the built tree, its errors, and the cells the
+//! overlay draws.
+
+use crate::limits::{LimitError, MAX_DUPLICATION_RANGE, MAX_MEMORY_BUDGET_MIB, MAX_OCTREE_DEPTH};
+use crate::math::Aabb;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct OctreeParams {
+    /// Deepest level a node may have; the root is level 0.
+    pub max_depth: u32,
+    /// A node with at most this many references stays a leaf.
+    pub leaf_size: u32,
+    /// Stop splitting where the surface-area cost estimate says a split
+    /// would cost more than it saves.
+    pub cost_driven: bool,
+    /// A node stays a leaf when its children would hold more than this many
+    /// times its references (8 never stops: eight children hold at most 8x).
+    #[serde(default = "default_max_duplication")]
+    pub max_duplication: u32,
+    /// Budget for the built structure (nodes and references), in MiB: past
+    /// it, nodes stay leaves.
+    #[serde(default = "default_memory_budget_mib")]
+    pub memory_budget_mib: u32,
+}
+
+/// Chosen by `glint bench --sweep` (benches/octree_sweep_256.md).
+pub const DEFAULT_MAX_DUPLICATION: u32 = 8;
+/// Far above what any real scene needs (the 65,536-triangle tetra_s8 takes
+/// 15 MiB), far below this machine's memory, and small enough that the
+/// build finishes in seconds even when a scene would use it all.
+pub const DEFAULT_MEMORY_BUDGET_MIB: u32 = 128;
+
+fn default_max_duplication() -> u32 {
+    DEFAULT_MAX_DUPLICATION
+}
+
+fn default_memory_budget_mib() -> u32 {
+    DEFAULT_MEMORY_BUDGET_MIB
+}
+
+impl Default for OctreeParams {
+    fn default() -> Self {
+        // Chosen by `glint bench --sweep` over the seven SPD scenes
+        // (benches/octree_sweep_256.md): leaf size 4 renders within 3% of
+        // the fastest configuration (run-to-run noise) with half its
+        // intersection tests, at most 0.33x Havran's best octree on every
+        // scene; depth 12 and leaf size 2 were slower.
+        Self {
+            max_depth: 10,
+            leaf_size: 4,
+            cost_driven: false,
+            max_duplication: DEFAULT_MAX_DUPLICATION,
+            memory_budget_mib: DEFAULT_MEMORY_BUDGET_MIB,
+        }
+    }
+}
+
+impl OctreeParams {
+    /// Every parameter within [`crate::limits`].
+    pub fn check(&self) -> Result<(), LimitError> {
+        if self.max_depth > MAX_OCTREE_DEPTH {
+            return Err(LimitError::OctreeDepth(self.max_depth));
+        }
+        if self.leaf_size == 0 {
+            return Err(LimitError::LeafSize);
+        }
+        if !MAX_DUPLICATION_RANGE.contains(&self.max_duplication) {
+            return Err(LimitError::MaxDuplication(self.max_duplication));
+        }
+        if !(1..=MAX_MEMORY_BUDGET_MIB).contains(&self.memory_budget_mib) {
+            return Err(LimitError::MemoryBudget(self.memory_budget_mib));
+        }
+        Ok(())
+    }
+
+    pub(super) fn memory_budget_bytes(&self) -> u64 {
+        self.memory_budget_mib as u64 * 1024 * 1024
+    }
+}
+
+#[derive(Debug, thiserror::Error, PartialEq, Eq)]
+pub enum OctreeError {
+    /// The allocator refused memory the build needed (for example under a
+    /// memory limit below the budget).
+    #[error(
+        "not enough memory to build the octree ({bytes} more bytes were refused); \
+         lower the octree memory budget or switch the octree off"
+    )]
+    OutOfMemory { bytes: u64 },
+}
+
+/// Machine-independent description of a built octree, with Havran's names:
+/// interior nodes N_IN = `nodes - leaves`, leaves N_V + N_EV = `leaves`,
+/// empty leaves N_EV, references N_OIV.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct OctreeStats {
+    pub nodes: u64,
+    pub leaves: u64,
+    pub empty_leaves: u64,
+    pub references: u64,
+    pub max_depth: u32,
+    pub memory_bytes: u64,
+    /// The budget the build had (`memory_budget_mib` in bytes).
+    pub memory_budget_bytes: u64,
+    /// Nodes left as leaves because splitting them would have exceeded
+    /// the budget (0 when the budget never bound).
+    pub leaves_stopped_by_budget: u64,
+    /// Nodes left as leaves because a split would not have separated their
+    /// references (`max_duplication`, or every child holding all of them).
+    pub leaves_stopped_by_duplication: u64,
+}
+
+/// A cell of the octree as the overlay draws it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OctreeCell {
+    pub bounds: Aabb,
+    /// Level of the cell; the root is 0.
+    pub depth: u32,
+    /// Primitive references in the cell (summed over its leaves when it
+    /// stands for a subtree).
+    pub references: u64,
+}

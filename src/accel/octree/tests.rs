@@ -1,0 +1,250 @@
+//! The octree's tests: its layout, its build, and its walk against brute force.
+
+use super::node::{Cell, INTERIOR, Node};
+use super::*;
+use crate::accel::Primitives;
+use crate::accel::{ShadowCrossings, closest_brute_force, occlusion_brute_force};
+use crate::math::DVec3;
+use crate::math::Ray;
+use crate::shapes::{Plane, PreparedRay, Shape, Sphere};
+use crate::stats::NoCounts;
+
+/// Every stored leaf: its cell and its references.
+fn leaves(tree: &Octree) -> Vec<(Cell, Vec<u32>)> {
+    fn walk(tree: &Octree, index: usize, cell: Cell, out: &mut Vec<(Cell, Vec<u32>)>) {
+        let node = tree.nodes[index];
+        if node.is_leaf() {
+            let first = node.first as usize;
+            out.push((
+                cell,
+                tree.refs[first..first + node.count() as usize].to_vec(),
+            ));
+            return;
+        }
+        for c in 0..8 {
+            if node.mask() >> c & 1 == 1 {
+                walk(tree, node.child(c) as usize, cell.child(c), out);
+            }
+        }
+    }
+    let mut out = Vec::new();
+    if !tree.nodes.is_empty() {
+        walk(tree, 0, tree.root_cell(), &mut out);
+    }
+    out
+}
+
+/// `n`^3 spheres of radius `radius` one unit apart, the first at the
+/// origin.
+fn sphere_grid(n: u32, radius: f64) -> Vec<Shape> {
+    let mut shapes = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            for k in 0..n {
+                let c = DVec3::new(i as f64, j as f64, k as f64);
+                shapes.push(Shape::Sphere(Sphere::new(c, radius)));
+            }
+        }
+    }
+    shapes
+}
+
+#[test]
+fn an_interior_node_finds_its_children_by_counting_octants_below() {
+    // Octants 0, 2, 5 and 7 hold something, stored from node 10 on.
+    let node = Node {
+        first: 10,
+        meta: INTERIOR | 0b1010_0101,
+    };
+    assert!(!node.is_leaf());
+    let children: Vec<u32> = [0, 2, 5, 7].map(|c| node.child(c)).to_vec();
+    assert_eq!(children, [10, 11, 12, 13]);
+}
+
+#[test]
+fn child_cells_tile_their_parent_exactly() {
+    let parent = Cell {
+        min: DVec3::new(-1.5, 0.25, 3.0),
+        side: 0.75,
+    };
+    let mut volume = 0.0;
+    for c in 0..8 {
+        let child = parent.child(c);
+        assert_eq!(child.side, 0.375);
+        for k in 0..3 {
+            let lower = parent.min[k];
+            let expected = if c >> k & 1 == 1 {
+                parent.mid()[k]
+            } else {
+                lower
+            };
+            assert_eq!(child.min[k], expected, "octant {c}, axis {k}");
+        }
+        volume += child.side.powi(3);
+    }
+    assert_eq!(volume, parent.side.powi(3));
+}
+
+#[test]
+fn every_shape_is_in_the_leaf_around_its_centre_and_only_in_leaves_it_overlaps() {
+    let mut shapes = sphere_grid(6, 0.3);
+    shapes.push(Shape::Plane(Plane::new(DVec3::ZERO, DVec3::Y)));
+    let tree = Octree::build(&shapes, OctreeParams::default()).unwrap();
+    assert_eq!(tree.unbounded, [216], "the plane is tested for every ray");
+    let leaves = leaves(&tree);
+    assert!(
+        leaves.len() > 8,
+        "the grid was split ({} leaves)",
+        leaves.len()
+    );
+    for (cell, refs) in &leaves {
+        for &r in refs {
+            let bounds = shapes[r as usize].bounds().unwrap();
+            assert!(
+                cell.aabb().padded(1e-9).overlaps(&bounds),
+                "shape {r} referenced by a leaf it does not touch"
+            );
+        }
+    }
+    for (index, shape) in shapes.iter().enumerate().take(216) {
+        let centre = shape.bounds().unwrap().center();
+        let around = leaves
+            .iter()
+            .filter(|(cell, _)| cell.aabb().contains(centre))
+            .collect::<Vec<_>>();
+        assert!(
+            !around.is_empty(),
+            "shape {index}: no leaf holds its centre"
+        );
+        for (_, refs) in around {
+            assert!(refs.contains(&(index as u32)), "shape {index} missing");
+        }
+    }
+    let stats = tree.stats();
+    let stored: u64 = leaves.iter().map(|(_, r)| r.len() as u64).sum();
+    assert_eq!(stats.references, stored);
+    // Every interior node has eight children, stored or not.
+    assert_eq!(stats.nodes, 1 + 8 * (stats.nodes - stats.leaves));
+}
+
+#[test]
+fn a_budget_too_small_for_any_split_keeps_one_leaf_that_answers_alike() {
+    let shapes = sphere_grid(4, 0.3);
+    let params = OctreeParams {
+        memory_budget_mib: 0,
+        ..OctreeParams::default()
+    };
+    let tree = Octree::build(&shapes, params).unwrap();
+    let stats = tree.stats();
+    assert_eq!(stats.nodes, 1);
+    assert_eq!(stats.leaves_stopped_by_budget, 1);
+    let prims = Primitives::opaque(&shapes);
+    for k in 0..16 {
+        let ray = PreparedRay::new(Ray::new(
+            DVec3::new(-2.0, k as f64 * 0.2, 1.1),
+            DVec3::new(1.0, 0.05, 0.02).normalize(),
+        ));
+        assert_eq!(
+            tree.closest(&prims, &ray, f64::INFINITY, &mut NoCounts),
+            closest_brute_force(&prims, &ray, f64::INFINITY, &mut NoCounts)
+        );
+    }
+}
+
+#[test]
+fn rays_in_split_planes_parallel_to_axes_and_through_corners_agree_with_brute_force() {
+    // Spheres that reach across the split planes. Rays lying in those
+    // planes, with zero direction components, are traversal's
+    // degenerate case (Revelles et al. 2000).
+    let shapes = sphere_grid(4, 0.6);
+    let tree = Octree::build(&shapes, OctreeParams::default()).unwrap();
+    let prims = Primitives::opaque(&shapes);
+    let root = tree.root_cell();
+    let plane = |quarters: f64| root.min.x + root.side * quarters / 4.0;
+    let mut rays = Vec::new();
+    for a in [plane(2.0), plane(1.0), plane(3.0), 1.0, 0.2] {
+        for b in [plane(2.0), plane(1.0), plane(3.0), 2.0, 0.0] {
+            rays.push(Ray::new(DVec3::new(-5.0, a, b), DVec3::X));
+            rays.push(Ray::new(DVec3::new(a, 9.0, b), -DVec3::Y));
+            rays.push(Ray::new(DVec3::new(a, b, -5.0), DVec3::Z));
+            rays.push(Ray::new(
+                DVec3::new(-5.0, -5.0 + a, b),
+                DVec3::new(1.0, 1.0, 0.0).normalize(),
+            ));
+        }
+    }
+    let mut hits = 0;
+    let (mut a, mut b) = (ShadowCrossings::default(), ShadowCrossings::default());
+    for ray in rays {
+        let ray = PreparedRay::new(ray);
+        let octree = tree.closest(&prims, &ray, f64::INFINITY, &mut NoCounts);
+        let brute = closest_brute_force(&prims, &ray, f64::INFINITY, &mut NoCounts);
+        assert_eq!(octree, brute, "{:?}", ray.ray);
+        hits += octree.is_some() as usize;
+        tree.occlusion(&prims, &ray, 20.0, &mut a, &mut NoCounts);
+        occlusion_brute_force(&prims, &ray, 20.0, &mut b, &mut NoCounts);
+        assert_eq!(a, b, "{:?}", ray.ray);
+    }
+    assert!(hits > 40, "the rays meet the grid ({hits} hits)");
+    // Rays through the centre of a root (a corner of all eight children)
+    // and along its mid-planes, in all eight direction-sign combinations,
+    // over spheres centred on those planes.
+    {
+        // A grid of small spheres centred on the split planes of a [-4, 4]^3 root.
+        let mut shapes = Vec::new();
+        for i in -4..=4 {
+            for j in -4..=4 {
+                shapes.push(Shape::Sphere(Sphere::new(
+                    DVec3::new(i as f64, j as f64, 0.0),
+                    0.2,
+                )));
+                shapes.push(Shape::Sphere(Sphere::new(
+                    DVec3::new(i as f64, 0.0, j as f64),
+                    0.2,
+                )));
+            }
+        }
+        let octree = Octree::build(
+            &shapes,
+            OctreeParams {
+                max_depth: 6,
+                leaf_size: 1,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let mut checked = 0;
+        for sx in [-1.0, 1.0] {
+            for sy in [-1.0, 1.0] {
+                for sz in [-1.0, 1.0] {
+                    for (origin, dir) in [
+                        // Through the root's centre, a corner of all eight children.
+                        (
+                            DVec3::new(-6.0 * sx, -6.0 * sy, -6.0 * sz),
+                            DVec3::new(sx, sy, sz),
+                        ),
+                        // In the plane z = 0, along x.
+                        (
+                            DVec3::new(-6.0 * sx, 0.0, 0.0),
+                            DVec3::new(sx, 0.0, 0.0 * sz),
+                        ),
+                        // In the plane y = 0, diagonal in x and z.
+                        (
+                            DVec3::new(-6.0 * sx, 0.0, -6.0 * sz),
+                            DVec3::new(sx, 0.0 * sy, sz),
+                        ),
+                    ] {
+                        let ray = PreparedRay::new(Ray::new(origin, dir.normalize()));
+                        let prims = Primitives::opaque(&shapes);
+                        let brute = closest_brute_force(&prims, &ray, f64::INFINITY, &mut NoCounts);
+                        let tree = octree.closest(&prims, &ray, f64::INFINITY, &mut NoCounts);
+                        assert_eq!(brute, tree, "origin {origin}, direction {dir}");
+                        assert!(brute.is_some(), "these rays all hit a sphere");
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert_eq!(checked, 24);
+    }
+}

@@ -1,0 +1,330 @@
+//! The timing panel: the passes of the image on screen (times, their
+//! ratio, the error anti-aliasing removes, rays, the octree's figures), the
+//! plot of every pass this session, and the view's colour scale.
+
+use egui::{Color32, RichText};
+use egui_plot::{Legend, Line, Plot, Points};
+
+use super::inspect::InspectState;
+use super::panels::RenderInfo;
+use super::state::EditState;
+use super::worker::{PassKind, PassRecord, Worker};
+use crate::settings::ViewMode;
+
+/// Pass times and ray counts, the octree's figures, the view's legend and
+/// the inspected pixel's ray tree.
+pub fn timing_ui(edit: &EditState, info: &RenderInfo, inspect: &InspectState, ui: &mut egui::Ui) {
+    // Scrolls both ways: a deep ray tree's headers (which do not wrap) must
+    // not widen the fixed-width panel over the image.
+    egui::ScrollArea::both().show(ui, |ui| {
+        timing_grid_ui(edit, info, ui);
+        legend_ui(info.worker, ui);
+        ui.separator();
+        ui.heading("Pixel");
+        super::pixel::ray_tree_ui(inspect.inspection.as_ref(), ui);
+    });
+}
+
+/// The colour scale of the cost and aa-need views, from the shown frame.
+fn legend_ui(worker: &Worker, ui: &mut egui::Ui) {
+    let legend = worker
+        .try_with_buffer(|b| b.last_frame.as_ref().and_then(|f| f.legend()))
+        .flatten();
+    let Some(legend) = legend else { return };
+    ui.separator();
+    ui.label(RichText::new(&legend.caption).strong());
+    let (rect, _) =
+        ui.allocate_exact_size(egui::vec2(ui.available_width(), 14.0), egui::Sense::hover());
+    let n = 64;
+    for k in 0..n {
+        let t = k as f64 / (n - 1) as f64;
+        let c = legend.ramp.color(t);
+        let x0 = rect.min.x + rect.width() * k as f32 / n as f32;
+        let x1 = rect.min.x + rect.width() * (k + 1) as f32 / n as f32;
+        ui.painter().rect_filled(
+            egui::Rect::from_min_max(egui::pos2(x0, rect.min.y), egui::pos2(x1 + 0.5, rect.max.y)),
+            0.0,
+            Color32::from_rgb(c[0], c[1], c[2]),
+        );
+    }
+    ui.horizontal(|ui| {
+        ui.label(&legend.low);
+        ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
+            ui.label(&legend.high);
+        });
+    });
+}
+
+fn timing_grid_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
+    let history = info.worker.history();
+    ui.heading("Timing");
+    // Figures compare passes of one image only: those of the newest
+    // generation that has a full pass (a preview is not one), so a toggle
+    // never shows a new 1-sample time against an old 16-sample time.
+    let shown = history
+        .iter()
+        .rev()
+        .find(|r| !matches!(r.kind, PassKind::Preview(_)))
+        .map(|r| r.generation);
+    let of_shown = |kind: PassKind| {
+        history
+            .iter()
+            .rev()
+            .find(|r| Some(r.generation) == shown && r.kind == kind)
+    };
+    let rendering = info.worker.generation() != shown.unwrap_or(0);
+    egui::Grid::new("timing-grid")
+        .num_columns(2)
+        .max_col_width(170.0)
+        .striped(true)
+        .show(ui, |ui| {
+            // Values wrap rather than widen the (fixed-width) panel.
+            let mut row = |label: &str, value: String| {
+                ui.label(label);
+                ui.add(egui::Label::new(value).wrap());
+                ui.end_row();
+            };
+            let pending = if rendering { "rendering…" } else { "–" };
+            if let Some(r) = of_shown(PassKind::Corners) {
+                row("SPD corner pass", format!("{:.3} s", r.seconds));
+            } else {
+                let one = of_shown(PassKind::OneSample);
+                let sixteen = of_shown(PassKind::SixteenSamples);
+                row(
+                    "1-sample pass",
+                    one.map_or(pending.into(), |r| format!("{:.3} s", r.seconds)),
+                );
+                if edit.settings.samples > 1 || sixteen.is_some() {
+                    row(
+                        "16-sample pass",
+                        sixteen.map_or(pending.into(), |r| format!("{:.3} s", r.seconds)),
+                    );
+                }
+                if let Some(r) = sixteen
+                    && let Some(refined) = r.refined_pixels
+                {
+                    row(
+                        "refined (adaptive)",
+                        format!(
+                            "{:.1}% of pixels",
+                            100.0 * refined as f64 / (r.width as f64 * r.height as f64).max(1.0)
+                        ),
+                    );
+                }
+                if let (Some(a), Some(b)) = (one, sixteen) {
+                    row(
+                        "16 / 1 time ratio",
+                        format!("{:.1}x", b.seconds / a.seconds.max(1e-9)),
+                    );
+                    // An error of pictures: not of depth, normals or costs.
+                    if b.view == ViewMode::Shaded
+                        && let Some(e) = b.one_sample_error
+                    {
+                        row(
+                            "1-sample error vs 16",
+                            format!("RMSE {:.4}, {:.1} dB", e.rmse_display, e.psnr_display),
+                        );
+                        row(
+                            "pixels AA changes",
+                            format!("{:.1}% (> 1/255)", 100.0 * e.visible_fraction),
+                        );
+                    }
+                }
+            }
+            if let Some((p, estimate)) = info.last_preview {
+                let measured = history
+                    .iter()
+                    .rev()
+                    .find(|r| r.kind == PassKind::Preview(p));
+                row(
+                    "while moving",
+                    match measured {
+                        Some(r) => format!(
+                            "{} ({:.0} ms; est. {:.0} of {:.0})",
+                            p.describe(),
+                            1000.0 * r.seconds,
+                            1000.0 * estimate,
+                            edit.frame_budget_ms
+                        ),
+                        None => format!("{} (est. {:.0} ms)", p.describe(), 1000.0 * estimate),
+                    },
+                );
+            }
+            if let Some(r) = history.iter().rev().find(|r| Some(r.generation) == shown) {
+                row(
+                    "Mrays/s (last pass)",
+                    format!("{:.2}", r.rays.total() as f64 / r.seconds.max(1e-9) / 1e6),
+                );
+                row("rays: primary", format!("{}", r.rays.primary));
+                row("rays: shadow", format!("{}", r.rays.shadow));
+                row("rays: reflection", format!("{}", r.rays.reflection));
+                row("rays: refraction", format!("{}", r.rays.refraction));
+            }
+            let stats = info.octree.stats();
+            row("octree build", format!("{:.3} s", info.build_seconds));
+            row(
+                "octree nodes",
+                format!("{} ({} leaves)", stats.nodes, stats.leaves),
+            );
+            row(
+                "octree memory",
+                format!("{:.1} KiB", stats.memory_bytes as f64 / 1024.0),
+            );
+            row("shapes", format!("{}", edit.scene.shapes.len()));
+        });
+    ui.separator();
+    pass_plot_ui(&history, ui);
+}
+
+/// The round number (1, 2 or 5 times a power of ten) nearest above `x`.
+fn round_step(x: f64) -> f64 {
+    if !(x > 0.0) {
+        return 1.0;
+    }
+    let power = 10f64.powf(x.log10().floor());
+    [1.0, 2.0, 5.0, 10.0]
+        .into_iter()
+        .map(|m| m * power)
+        .find(|&s| s >= x)
+        .unwrap_or(10.0 * power)
+}
+
+/// A session-time tick: blank left of 0 (the legend's room), with as many
+/// decimals as the step needs so that neighbouring ticks never read alike.
+fn time_tick_label(value: f64, step: f64) -> String {
+    if value < -0.5 * step {
+        return String::new();
+    }
+    let decimals = if step >= 1.0 {
+        0
+    } else {
+        (-step.log10()).ceil() as usize
+    };
+    // Grid values carry rounding error: the tick at 0 may be -1e-17.
+    let value = if value.abs() < 0.5 * step { 0.0 } else { value };
+    format!("{value:.decimals$}")
+}
+
+/// Every full pass of the session, one series per octree and anti-aliasing
+/// setting so each toggle shows as a jump between series, on a logarithmic
+/// time axis (a 100 s pass with the octree off must not flatten the rest).
+fn pass_plot_ui(history: &[PassRecord], ui: &mut egui::Ui) {
+    ui.label("Pass times this session (log scale)");
+    let series = [
+        (
+            true,
+            false,
+            "octree on, 1 spp",
+            Color32::from_rgb(80, 160, 255),
+        ),
+        (
+            false,
+            false,
+            "octree off, 1 spp",
+            Color32::from_rgb(255, 120, 80),
+        ),
+        (
+            true,
+            true,
+            "octree on, 16 spp",
+            Color32::from_rgb(60, 200, 120),
+        ),
+        (
+            false,
+            true,
+            "octree off, 16 spp",
+            Color32::from_rgb(230, 190, 60),
+        ),
+    ];
+    let full: Vec<_> = history
+        .iter()
+        .filter(|r| !matches!(r.kind, PassKind::Preview(_)))
+        .collect();
+    let log = |s: f64| s.max(1e-4).log10();
+    // Whole decades around the data, so the axis always shows at least two
+    // labelled ticks; the time axis starts at 0 and reaches past the newest
+    // point, leaving room on the left for the legend.
+    let (lo, hi) = full
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), r| {
+            (lo.min(log(r.seconds)), hi.max(log(r.seconds)))
+        });
+    let (lo, hi) = if lo.is_finite() {
+        (lo.floor(), hi.ceil().max(lo.floor() + 1.0))
+    } else {
+        (-2.0, 0.0)
+    };
+    let newest = full.iter().map(|r| r.finished_at).fold(1.0f64, f64::max);
+    Plot::new("pass-times")
+        .height(190.0)
+        .legend(Legend::default().position(egui_plot::Corner::LeftTop))
+        .allow_drag(false)
+        .allow_zoom(false)
+        .allow_scroll(false)
+        .include_y(lo)
+        .include_y(hi + 0.6)
+        .include_x(-0.35 * newest)
+        .include_x(newest * 1.05)
+        .x_axis_label("session time (s)")
+        // Labelled ticks at a round step, about three across the axis:
+        // egui_plot hides labels closer than 60 points, and the plot is
+        // about 250 points wide.
+        .x_grid_spacer(egui_plot::uniform_grid_spacer(|input| {
+            let step = round_step((input.bounds.1 - input.bounds.0) / 3.0);
+            [step, step, step]
+        }))
+        .y_grid_spacer(egui_plot::uniform_grid_spacer(|_| [1.0, 1.0, 1.0]))
+        .y_axis_formatter(|mark, _| {
+            let seconds = 10f64.powf(mark.value);
+            if seconds < 1.0 {
+                format!("{:.0} ms", seconds * 1000.0)
+            } else {
+                format!("{seconds:.0} s")
+            }
+        })
+        .x_axis_formatter(|mark, _| time_tick_label(mark.value, mark.step_size))
+        .show(ui, |plot| {
+            for (octree, sixteen, name, color) in series {
+                let points: Vec<[f64; 2]> = full
+                    .iter()
+                    .filter(|r| {
+                        r.octree == octree && (r.kind == PassKind::SixteenSamples) == sixteen
+                    })
+                    .map(|r| [r.finished_at, log(r.seconds)])
+                    .collect();
+                if !points.is_empty() {
+                    plot.line(Line::new(name, points.clone()).color(color));
+                    plot.points(Points::new(name, points).color(color).radius(3.0));
+                }
+            }
+        });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_steps_are_one_two_or_five_times_a_power_of_ten() {
+        assert_eq!(round_step(0.28), 0.5);
+        assert_eq!(round_step(8.1), 10.0);
+        assert_eq!(round_step(13.0), 20.0);
+        assert_eq!(round_step(2.0), 2.0);
+        assert_eq!(round_step(0.0), 1.0);
+        assert_eq!(round_step(f64::NAN), 1.0);
+    }
+
+    #[test]
+    fn neighbouring_time_ticks_never_read_alike() {
+        // A session under a second: steps of 0.5 once printed "0 0 1".
+        let labels: Vec<_> = [-0.5, -1e-17, 0.5, 1.0]
+            .iter()
+            .map(|&v| time_tick_label(v, 0.5))
+            .collect();
+        assert_eq!(labels, ["", "0.0", "0.5", "1.0"]);
+        assert_eq!(time_tick_label(0.2, 0.1), "0.2");
+        assert_eq!(time_tick_label(0.05, 0.05), "0.05");
+        assert_eq!(time_tick_label(30.0, 10.0), "30");
+        assert_eq!(time_tick_label(-10.0, 10.0), "");
+    }
+}
