@@ -159,6 +159,7 @@ fn closed_mesh_is_watertight_from_inside() {
             &glint::accel::Primitives::opaque(&shapes),
             &ray,
             f64::INFINITY,
+            &mut glint::accel::WalkStack::default(),
             &mut glint::stats::NoCounts,
         );
         assert_eq!(brute, tree);

@@ -92,13 +92,13 @@ proptest! {
         for ray in rays {
             let prepared = PreparedRay::new(ray);
             let brute = closest_brute_force(&prims, &prepared, f64::INFINITY, &mut NoCounts);
-            let tree = octree.closest(&prims, &prepared, f64::INFINITY, &mut NoCounts);
+            let tree = octree.closest(&prims, &prepared, f64::INFINITY, &mut glint::accel::WalkStack::default(), &mut NoCounts);
             prop_assert_eq!(brute, tree, "closest hit differs for {:?}", ray);
             let mut b = ShadowCrossings::default();
             occlusion_brute_force(&prims, &prepared, shadow_length, &mut b, &mut NoCounts);
             // Left over from another ray: cleared by the query.
             let mut t = b.clone();
-            octree.occlusion(&prims, &prepared, shadow_length, &mut t, &mut NoCounts);
+            octree.occlusion(&prims, &prepared, shadow_length, &mut t, &mut glint::accel::WalkStack::default(), &mut NoCounts);
             prop_assert_eq!(b, t, "shadow verdict differs for {:?}", ray);
         }
     }

@@ -346,7 +346,13 @@ fn coincident_triangles_stop_splitting_instead_of_multiplying() {
         -DVec3::Y,
     ));
     let hit = octree
-        .closest(&prims, &ray, f64::INFINITY, &mut glint::stats::NoCounts)
+        .closest(
+            &prims,
+            &ray,
+            f64::INFINITY,
+            &mut glint::accel::WalkStack::default(),
+            &mut glint::stats::NoCounts,
+        )
         .unwrap();
     assert_eq!(
         (hit.shape, hit.hit.t),

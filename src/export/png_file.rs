@@ -26,6 +26,10 @@ pub(super) fn write_png(
     let mut encoder = png::Encoder::new(out, width, height);
     encoder.set_color(png::ColorType::Rgb);
     encoder.set_depth(png::BitDepth::Eight);
+    // fdeflate: at the default level, writing a 256x192 render took more
+    // instructions (583 a pixel) than tracing it; this takes a tenth of
+    // that, for files 7% (default.toml) to 46% (bunny normals) larger.
+    encoder.set_compression(png::Compression::Fast);
     encoder
         .add_text_chunk(
             "Software".into(),

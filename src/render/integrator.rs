@@ -9,7 +9,7 @@ use crate::settings::Protocol;
 use crate::shapes::PreparedRay;
 use crate::stats::{Counter, RayCounts};
 
-use super::renderer::Renderer;
+use super::renderer::{Query, Renderer};
 
 /// A hit resolved for shading: where, which way the surface faces, and
 /// with what material.
@@ -30,11 +30,11 @@ impl Renderer<'_> {
         &self,
         ray: &Ray,
         depth: u32,
-        counter: &mut C,
+        query: &mut Query<C>,
         rays: &mut RayCounts,
         rec: &mut R,
     ) -> Color {
-        let Some(at) = self.shading_point(ray, counter, rec) else {
+        let Some(at) = self.shading_point(ray, query, rec) else {
             let background = self.background;
             rec.local(background);
             rec.finish(background);
@@ -43,10 +43,10 @@ impl Renderer<'_> {
         if depth == 1 {
             rays.primary_hits += 1;
         }
-        let mut color = self.direct_light(ray, &at, counter, rays, rec);
+        let mut color = self.direct_light(ray, &at, query, rays, rec);
         rec.local(color);
         if depth < self.settings.max_depth {
-            self.secondary_rays(ray, &at, depth, &mut color, counter, rays, rec);
+            self.secondary_rays(ray, &at, depth, &mut color, query, rays, rec);
         }
         rec.finish(color);
         color
@@ -57,10 +57,10 @@ impl Renderer<'_> {
     fn shading_point<C: Counter, R: RayRecorder>(
         &self,
         ray: &Ray,
-        counter: &mut C,
+        query: &mut Query<C>,
         rec: &mut R,
     ) -> Option<ShadingPoint> {
-        let hit = self.closest(&PreparedRay::new(*ray), counter)?;
+        let hit = self.closest(&PreparedRay::new(*ray), query)?;
         let scene = self.scene;
         let shape = &scene.shapes[hit.shape as usize];
         let surface = shape.surface(ray, &hit.hit, &scene.vertex_normals);
@@ -107,7 +107,7 @@ impl Renderer<'_> {
         &self,
         ray: &Ray,
         at: &ShadingPoint,
-        counter: &mut C,
+        query: &mut Query<C>,
         rays: &mut RayCounts,
         rec: &mut R,
     ) -> Color {
@@ -150,7 +150,7 @@ impl Renderer<'_> {
             let pass = if self.settings.shadows {
                 rays.shadow += 1;
                 let shadow = PreparedRay::new(Ray::new(shadow_origin, l));
-                self.transmittance(&shadow, distance, counter)
+                self.transmittance(&shadow, distance, query)
             } else {
                 1.0
             };
@@ -160,8 +160,14 @@ impl Renderer<'_> {
                 continue;
             }
             let diffuse = material.kd * n_dot_l * material.color;
-            let r = 2.0 * n_dot_l * n - l;
-            let specular = material.ks * r.dot(view).max(0.0).powf(material.shininess);
+            // Without a highlight the Phong term is exactly 0 (its power is
+            // at most 1): skip the power, the costliest step of shading.
+            let specular = if material.ks == 0.0 {
+                0.0
+            } else {
+                let r = 2.0 * n_dot_l * n - l;
+                material.ks * r.dot(view).max(0.0).powf(material.shininess)
+            };
             let direct = (diffuse + DVec3::splat(specular)) * light.color * pass;
             rec.shadow(|| {
                 let kind = if pass < 1.0 {
@@ -185,7 +191,7 @@ impl Renderer<'_> {
         at: &ShadingPoint,
         depth: u32,
         color: &mut Color,
-        counter: &mut C,
+        query: &mut Query<C>,
         rays: &mut RayCounts,
         rec: &mut R,
     ) {
@@ -205,7 +211,7 @@ impl Renderer<'_> {
                     let child_ray = Ray::new(origin, dir);
                     let weight = material.transparency;
                     let mut child = rec.child(RayKind::Refraction, &child_ray, depth + 1, weight);
-                    let seen = self.trace(&child_ray, depth + 1, counter, rays, &mut child);
+                    let seen = self.trace(&child_ray, depth + 1, query, rays, &mut child);
                     rec.attach(child, seen);
                     *color += weight * seen;
                 }
@@ -233,7 +239,7 @@ impl Renderer<'_> {
             let origin = offset_ray_origin(p, facing, self.floor_scale);
             let child_ray = Ray::new(origin, dir.normalize());
             let mut child = rec.child(RayKind::Reflection, &child_ray, depth + 1, reflect_weight);
-            let seen = self.trace(&child_ray, depth + 1, counter, rays, &mut child);
+            let seen = self.trace(&child_ray, depth + 1, query, rays, &mut child);
             rec.attach(child, seen);
             *color += reflect_weight * seen;
         }

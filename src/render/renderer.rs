@@ -4,7 +4,8 @@
 //! the integrator asks.
 
 use crate::accel::{
-    ClosestHit, Octree, Primitives, ShadowCrossings, closest_brute_force, occlusion_brute_force,
+    ClosestHit, Octree, Primitives, ShadowCrossings, WalkStack, closest_brute_force,
+    occlusion_brute_force,
 };
 use crate::camera::{Camera, CameraError, CameraSpec, sample_offsets};
 use crate::limits::LimitError;
@@ -36,11 +37,20 @@ pub enum RenderError {
     },
 }
 
-thread_local! {
-    /// A shadow ray's crossings, kept per thread: the array is set up once,
-    /// not for every ray.
-    static SHADOW_CROSSINGS: std::cell::RefCell<ShadowCrossings> =
-        std::cell::RefCell::new(ShadowCrossings::default());
+/// Scratch space for ray queries: the octree walk's stack and a shadow
+/// ray's crossings. One per tile (or per inspected pixel), so no ray sets
+/// them up.
+#[derive(Default)]
+pub struct Scratch {
+    stack: WalkStack,
+    crossings: ShadowCrossings,
+}
+
+/// What a ray's queries use besides the scene: the counter of their work
+/// (Havran's measures, or nothing) and the scratch space.
+pub(super) struct Query<'s, C> {
+    pub counter: &'s mut C,
+    pub scratch: &'s mut Scratch,
 }
 
 /// Crossings of one material closer than this, relative to the scene's
@@ -151,13 +161,15 @@ impl<'a> Renderer<'a> {
     pub(super) fn closest<C: Counter>(
         &self,
         ray: &PreparedRay,
-        counter: &mut C,
+        query: &mut Query<C>,
     ) -> Option<ClosestHit> {
         let prims = self.primitives();
         if self.settings.use_octree {
-            self.octree.closest(&prims, ray, f64::INFINITY, counter)
+            let stack = &mut query.scratch.stack;
+            self.octree
+                .closest(&prims, ray, f64::INFINITY, stack, query.counter)
         } else {
-            closest_brute_force(&prims, ray, f64::INFINITY, counter)
+            closest_brute_force(&prims, ray, f64::INFINITY, query.counter)
         }
     }
 
@@ -172,17 +184,17 @@ impl<'a> Renderer<'a> {
         &self,
         ray: &PreparedRay,
         distance: f64,
-        counter: &mut C,
+        query: &mut Query<C>,
     ) -> f64 {
-        SHADOW_CROSSINGS.with_borrow_mut(|found| {
-            let prims = self.primitives();
-            if self.settings.use_octree {
-                self.octree.occlusion(&prims, ray, distance, found, counter);
-            } else {
-                occlusion_brute_force(&prims, ray, distance, found, counter);
-            }
-            self.pass_through(found)
-        })
+        let prims = self.primitives();
+        let Scratch { stack, crossings } = &mut *query.scratch;
+        if self.settings.use_octree {
+            self.octree
+                .occlusion(&prims, ray, distance, crossings, stack, query.counter);
+        } else {
+            occlusion_brute_force(&prims, ray, distance, crossings, query.counter);
+        }
+        self.pass_through(crossings)
     }
 
     /// The light a shadow ray's crossings let through.
@@ -220,7 +232,12 @@ impl<'a> Renderer<'a> {
         let ray = self.camera.ray(i, j, offset, offset);
         let mut root = RayNode::new(RayKind::Eye, &ray, 1, 1.0);
         let mut rays = RayCounts::default();
-        self.trace(&ray, 1, &mut NoCounts, &mut rays, &mut root);
+        let mut scratch = Scratch::default();
+        let mut query = Query {
+            counter: &mut NoCounts,
+            scratch: &mut scratch,
+        };
+        self.trace(&ray, 1, &mut query, &mut rays, &mut root);
         root
     }
 }

@@ -9,7 +9,7 @@ use crate::shapes::PreparedRay;
 use crate::stats::{Counter, NoCounts, RayCounts, RenderCounts, WorkCounts};
 
 use super::adaptive::Signature;
-use super::renderer::Renderer;
+use super::renderer::{Query, Renderer, Scratch};
 use super::tiles::Tile;
 
 /// What one tile of a pass computes.
@@ -43,19 +43,28 @@ pub(super) struct TileOutput {
 impl Renderer<'_> {
     /// Runs `job` over `tile`, counting Havran's work measures when
     /// `count_work` (tracing is generic over the counter, so the other
-    /// case costs nothing).
+    /// case costs nothing). The tile's rays share one scratch space.
     pub(super) fn run_tile(&self, job: TileJob, tile: Tile, count_work: bool) -> TileOutput {
         let mut out = TileOutput {
             values: Vec::with_capacity(tile.pixels()),
             signatures: Vec::new(),
             counts: RenderCounts::default(),
         };
+        let mut scratch = Scratch::default();
         if count_work {
             let mut work = WorkCounts::default();
-            self.fill_tile(job, tile, &mut work, &mut out);
+            let mut query = Query {
+                counter: &mut work,
+                scratch: &mut scratch,
+            };
+            self.fill_tile(job, tile, &mut query, &mut out);
             out.counts.work = work;
         } else {
-            self.fill_tile(job, tile, &mut NoCounts, &mut out);
+            let mut query = Query {
+                counter: &mut NoCounts,
+                scratch: &mut scratch,
+            };
+            self.fill_tile(job, tile, &mut query, &mut out);
         }
         out
     }
@@ -64,7 +73,7 @@ impl Renderer<'_> {
         &self,
         job: TileJob,
         tile: Tile,
-        counter: &mut C,
+        query: &mut Query<C>,
         out: &mut TileOutput,
     ) {
         let width = self.settings.width;
@@ -77,25 +86,25 @@ impl Renderer<'_> {
                         let mut signature = Signature::default();
                         pixel.add(self.sample_recorded(
                             &ray,
-                            counter,
+                            query,
                             &mut out.counts,
                             &mut signature,
                         ));
                         out.signatures.push(signature.value);
                     } else {
-                        pixel.add(self.sample(&ray, counter, &mut out.counts));
+                        pixel.add(self.sample(&ray, query, &mut out.counts));
                     }
                     pixel.value(self.settings.view, true)
                 }
-                TileJob::Grid => self.grid_pixel(i, j, counter, &mut out.counts),
+                TileJob::Grid => self.grid_pixel(i, j, query, &mut out.counts),
                 TileJob::Corners => {
-                    self.sample(&self.camera.ray(i, j, 0.0, 0.0), counter, &mut out.counts)
+                    self.sample(&self.camera.ray(i, j, 0.0, 0.0), query, &mut out.counts)
                 }
                 TileJob::Refine { first, mask } => {
                     let at = (j * width + i) as usize;
                     if mask[at] {
                         out.counts.refined_pixels += 1;
-                        self.grid_pixel(i, j, counter, &mut out.counts)
+                        self.grid_pixel(i, j, query, &mut out.counts)
                     } else {
                         first[at]
                     }
@@ -110,12 +119,12 @@ impl Renderer<'_> {
         &self,
         i: u32,
         j: u32,
-        counter: &mut C,
+        query: &mut Query<C>,
         counts: &mut RenderCounts,
     ) -> DVec3 {
         let mut pixel = PixelSum::default();
         for &(dx, dy) in &self.grid {
-            pixel.add(self.sample(&self.camera.ray(i, j, dx, dy), counter, counts));
+            pixel.add(self.sample(&self.camera.ray(i, j, dx, dy), query, counts));
         }
         pixel.value(self.settings.view, true)
     }
@@ -126,17 +135,17 @@ impl Renderer<'_> {
     pub(super) fn sample<C: Counter>(
         &self,
         ray: &Ray,
-        counter: &mut C,
+        query: &mut Query<C>,
         counts: &mut RenderCounts,
     ) -> DVec3 {
-        self.sample_recorded(ray, counter, counts, &mut NoRecord)
+        self.sample_recorded(ray, query, counts, &mut NoRecord)
     }
 
     /// [`Renderer::sample`], telling `rec` what the ray met.
     fn sample_recorded<C: Counter, R: RayRecorder>(
         &self,
         ray: &Ray,
-        counter: &mut C,
+        query: &mut Query<C>,
         counts: &mut RenderCounts,
         rec: &mut R,
     ) -> DVec3 {
@@ -145,17 +154,21 @@ impl Renderer<'_> {
         let value = if view.is_cost() {
             // Count this ray's work on its own, then pass it on.
             let mut work = WorkCounts::default();
-            self.trace(ray, 1, &mut work, &mut counts.rays, rec);
-            counter.add_work(&work);
+            let mut own = Query {
+                counter: &mut work,
+                scratch: &mut *query.scratch,
+            };
+            self.trace(ray, 1, &mut own, &mut counts.rays, rec);
+            query.counter.add_work(&work);
             DVec3::new(
                 work.intersection_tests as f64,
                 work.traversal_steps as f64,
                 work.leaves_visited as f64,
             )
         } else if view.traces_shading() {
-            self.trace(ray, 1, counter, &mut counts.rays, rec)
+            self.trace(ray, 1, query, &mut counts.rays, rec)
         } else {
-            self.inspect(ray, counter, &mut counts.rays)
+            self.inspect(ray, query, &mut counts.rays)
         };
         if value.is_finite() {
             value
@@ -166,9 +179,9 @@ impl Renderer<'_> {
     }
 
     /// One sample of a non-shaded view for the eye ray `ray`.
-    fn inspect<C: Counter>(&self, ray: &Ray, counter: &mut C, rays: &mut RayCounts) -> DVec3 {
+    fn inspect<C: Counter>(&self, ray: &Ray, query: &mut Query<C>, rays: &mut RayCounts) -> DVec3 {
         let prepared = PreparedRay::new(*ray);
-        let Some(hit) = self.closest(&prepared, counter) else {
+        let Some(hit) = self.closest(&prepared, query) else {
             return DVec3::ZERO;
         };
         rays.primary_hits += 1;

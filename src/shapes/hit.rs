@@ -5,15 +5,25 @@
 
 use crate::math::{DVec3, Ray};
 
-/// A ray prepared once for many intersection tests: the watertight triangle
-/// test's shear constants (Woop, Benthin & Wald 2013) are computed here.
+/// A ray prepared once for every query it takes part in: the octree walk's
+/// reciprocal direction and sign bits, and the watertight triangle test's
+/// axis permutation and shear constants (Woop, Benthin & Wald 2013).
 #[derive(Clone, Copy, Debug)]
 pub struct PreparedRay {
     pub ray: Ray,
-    /// Axis of the largest direction component, and the two others.
-    pub(super) kx: usize,
-    pub(super) ky: usize,
-    pub(super) kz: usize,
+    /// `1 / dir` per axis, and 0 where a component is too small to invert:
+    /// the walk then treats the ray as parallel to that axis's planes,
+    /// which moves it by less than the cells' padding over any finite
+    /// distance.
+    pub inv_dir: [f64; 3],
+    /// Bit `k`: the direction's component `k` is negative (components
+    /// treated as parallel count as positive).
+    pub negative: u32,
+    /// Bit `k`: component `k` is treated as parallel (see `inv_dir`).
+    pub parallel: u32,
+    /// Axis of the largest direction component, and the two others, as
+    /// one of six permutations (see [`PreparedRay::axes`]).
+    pub(super) permutation: u8,
     pub(super) shear: DVec3,
 }
 
@@ -35,12 +45,40 @@ impl PreparedRay {
             std::mem::swap(&mut kx, &mut ky);
         }
         let shear = DVec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
+        let permutation = (2 * kz + (d[kz] < 0.0) as usize) as u8;
+        debug_assert_eq!(Self::axes_of(permutation), (kx, ky, kz));
+        let mut inv_dir = [0.0; 3];
+        let (mut negative, mut parallel) = (0, 0);
+        for (k, inv_k) in inv_dir.iter_mut().enumerate() {
+            let inv = 1.0 / d[k];
+            if inv.is_finite() {
+                *inv_k = inv;
+                negative |= ((d[k] < 0.0) as u32) << k;
+            } else {
+                parallel |= 1 << k;
+            }
+        }
         Self {
             ray,
-            kx,
-            ky,
-            kz,
+            inv_dir,
+            negative,
+            parallel,
+            permutation,
             shear,
+        }
+    }
+
+    /// The permutation's axes `(kx, ky, kz)`: `kz` the dominant one, the
+    /// others in cyclic order, swapped when the dominant component is
+    /// negative.
+    pub(super) fn axes_of(permutation: u8) -> (usize, usize, usize) {
+        match permutation {
+            0 => (1, 2, 0),
+            1 => (2, 1, 0),
+            2 => (2, 0, 1),
+            3 => (0, 2, 1),
+            4 => (0, 1, 2),
+            _ => (1, 0, 2),
         }
     }
 }

@@ -49,14 +49,33 @@ impl Triangle {
     /// a shared edge or vertex hit at least one of the triangles that share it.
     #[inline]
     pub fn intersect(&self, r: &PreparedRay, t_max: f64) -> Option<ShapeHit> {
+        // The axes are a run-time choice per ray: dispatching once to code
+        // with constant axes avoids indexing vectors by a variable.
+        match r.permutation {
+            0 => self.intersect_along::<1, 2, 0>(r, t_max),
+            1 => self.intersect_along::<2, 1, 0>(r, t_max),
+            2 => self.intersect_along::<2, 0, 1>(r, t_max),
+            3 => self.intersect_along::<0, 2, 1>(r, t_max),
+            4 => self.intersect_along::<0, 1, 2>(r, t_max),
+            _ => self.intersect_along::<1, 0, 2>(r, t_max),
+        }
+    }
+
+    /// [`Triangle::intersect`] for a ray whose permutation is `(KX, KY, KZ)`.
+    #[inline(always)]
+    fn intersect_along<const KX: usize, const KY: usize, const KZ: usize>(
+        &self,
+        r: &PreparedRay,
+        t_max: f64,
+    ) -> Option<ShapeHit> {
         let o = r.ray.origin;
-        let (kx, ky, kz, s) = (r.kx, r.ky, r.kz, r.shear);
-        let a = self.vertices[0] - o;
-        let b = self.vertices[1] - o;
-        let c = self.vertices[2] - o;
-        let (ax, ay) = (a[kx] - s.x * a[kz], a[ky] - s.y * a[kz]);
-        let (bx, by) = (b[kx] - s.x * b[kz], b[ky] - s.y * b[kz]);
-        let (cx, cy) = (c[kx] - s.x * c[kz], c[ky] - s.y * c[kz]);
+        let s = r.shear;
+        let a = (self.vertices[0] - o).to_array();
+        let b = (self.vertices[1] - o).to_array();
+        let c = (self.vertices[2] - o).to_array();
+        let (ax, ay) = (a[KX] - s.x * a[KZ], a[KY] - s.y * a[KZ]);
+        let (bx, by) = (b[KX] - s.x * b[KZ], b[KY] - s.y * b[KZ]);
+        let (cx, cy) = (c[KX] - s.x * c[KZ], c[KY] - s.y * c[KZ]);
         let u = cx * by - cy * bx;
         let v = ax * cy - ay * cx;
         let w = bx * ay - by * ax;
@@ -67,7 +86,7 @@ impl Triangle {
         if det == 0.0 {
             return None;
         }
-        let t_scaled = s.z * (u * a[kz] + v * b[kz] + w * c[kz]);
+        let t_scaled = s.z * (u * a[KZ] + v * b[KZ] + w * c[KZ]);
         let t = t_scaled / det;
         if !(t > 0.0 && t < t_max) {
             return None;

@@ -7,6 +7,7 @@ use rayon::prelude::*;
 use super::node::{Cell, INTERIOR, Node};
 use super::params::{OctreeError, OctreeParams, OctreeStats};
 use super::tree::Octree;
+use super::walk::LEVEL_MASK;
 use crate::math::{Aabb, DVec3};
 use crate::shapes::Shape;
 
@@ -49,6 +50,7 @@ impl Octree {
                 memory_budget_bytes: params.memory_budget_bytes(),
                 ..OctreeStats::default()
             },
+            sides: [0.0; LEVEL_MASK + 1],
         };
         if bounded.is_empty() {
             return Ok(tree);
@@ -109,6 +111,7 @@ impl Octree {
                 + (tree.refs.len() + tree.unbounded.len()) * 4) as u64,
             ..stats
         };
+        tree.set_sides();
         Ok(tree)
     }
 }

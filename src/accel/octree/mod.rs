@@ -33,6 +33,7 @@ mod walk;
 
 pub use params::{DEFAULT_MEMORY_BUDGET_MIB, OctreeCell, OctreeError, OctreeParams, OctreeStats};
 pub use tree::Octree;
+pub use walk::WalkStack;
 
 #[cfg(test)]
 mod tests;

@@ -57,7 +57,7 @@ impl Cell {
         0.5 * self.side
     }
 
-    #[inline(always)]
+    #[cfg(test)]
     pub(super) fn mid(&self) -> DVec3 {
         self.min + DVec3::splat(self.half())
     }

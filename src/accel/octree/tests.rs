@@ -145,7 +145,13 @@ fn a_budget_too_small_for_any_split_keeps_one_leaf_that_answers_alike() {
             DVec3::new(1.0, 0.05, 0.02).normalize(),
         ));
         assert_eq!(
-            tree.closest(&prims, &ray, f64::INFINITY, &mut NoCounts),
+            tree.closest(
+                &prims,
+                &ray,
+                f64::INFINITY,
+                &mut super::WalkStack::default(),
+                &mut NoCounts
+            ),
             closest_brute_force(&prims, &ray, f64::INFINITY, &mut NoCounts)
         );
     }
@@ -177,11 +183,24 @@ fn rays_in_split_planes_parallel_to_axes_and_through_corners_agree_with_brute_fo
     let (mut a, mut b) = (ShadowCrossings::default(), ShadowCrossings::default());
     for ray in rays {
         let ray = PreparedRay::new(ray);
-        let octree = tree.closest(&prims, &ray, f64::INFINITY, &mut NoCounts);
+        let octree = tree.closest(
+            &prims,
+            &ray,
+            f64::INFINITY,
+            &mut super::WalkStack::default(),
+            &mut NoCounts,
+        );
         let brute = closest_brute_force(&prims, &ray, f64::INFINITY, &mut NoCounts);
         assert_eq!(octree, brute, "{:?}", ray.ray);
         hits += octree.is_some() as usize;
-        tree.occlusion(&prims, &ray, 20.0, &mut a, &mut NoCounts);
+        tree.occlusion(
+            &prims,
+            &ray,
+            20.0,
+            &mut a,
+            &mut super::WalkStack::default(),
+            &mut NoCounts,
+        );
         occlusion_brute_force(&prims, &ray, 20.0, &mut b, &mut NoCounts);
         assert_eq!(a, b, "{:?}", ray.ray);
     }
@@ -237,7 +256,13 @@ fn rays_in_split_planes_parallel_to_axes_and_through_corners_agree_with_brute_fo
                         let ray = PreparedRay::new(Ray::new(origin, dir.normalize()));
                         let prims = Primitives::opaque(&shapes);
                         let brute = closest_brute_force(&prims, &ray, f64::INFINITY, &mut NoCounts);
-                        let tree = octree.closest(&prims, &ray, f64::INFINITY, &mut NoCounts);
+                        let tree = octree.closest(
+                            &prims,
+                            &ray,
+                            f64::INFINITY,
+                            &mut super::WalkStack::default(),
+                            &mut NoCounts,
+                        );
                         assert_eq!(brute, tree, "origin {origin}, direction {dir}");
                         assert!(brute.is_some(), "these rays all hit a sphere");
                         checked += 1;

@@ -4,6 +4,7 @@
 
 use super::node::{Cell, Node};
 use super::params::{OctreeCell, OctreeParams, OctreeStats};
+use super::walk::LEVEL_MASK;
 use crate::math::Aabb;
 
 #[derive(Clone, Debug)]
@@ -15,6 +16,9 @@ pub struct Octree {
     pub(super) unbounded: Vec<u32>,
     pub(super) params: OctreeParams,
     pub(super) stats: OctreeStats,
+    /// The side of a cell at each level, halved from the root's exactly as
+    /// the build halves it.
+    pub(super) sides: [f64; LEVEL_MASK + 1],
 }
 
 impl Octree {
@@ -39,6 +43,15 @@ impl Octree {
             self.collect_cells(0, self.root_cell(), 0, depth, &mut out);
         }
         out
+    }
+
+    /// Fills the side table from the root cell.
+    pub(super) fn set_sides(&mut self) {
+        let mut side = self.root_cell().side;
+        for s in self.sides.iter_mut() {
+            *s = side;
+            side *= 0.5;
+        }
     }
 
     pub(super) fn root_cell(&self) -> Cell {

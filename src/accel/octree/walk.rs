@@ -5,20 +5,19 @@
 use super::super::primitives::{
     ClosestHit, Primitives, ShadowCrossings, test_closest, test_occlusion,
 };
-use super::node::Cell;
 use super::tree::Octree;
 use crate::limits::MAX_OCTREE_DEPTH;
-use crate::math::DVec3;
 use crate::shapes::PreparedRay;
 use crate::stats::Counter;
 
 impl Octree {
-    /// Closest hit with `0 < t < t_max`.
+    /// Closest hit with `0 < t < t_max`; `stack` is the caller's scratch.
     pub fn closest<C: Counter>(
         &self,
         prims: &Primitives,
         ray: &PreparedRay,
         t_max: f64,
+        stack: &mut WalkStack,
         counter: &mut C,
     ) -> Option<ClosestHit> {
         let mut visitor = ClosestVisitor {
@@ -33,7 +32,7 @@ impl Octree {
             test_closest(prims, i, ray, &mut visitor.best, t_max, visitor.counter);
         }
         let limit = visitor.best.map_or(t_max, |b| b.hit.t);
-        self.traverse(ray, limit, &mut visitor);
+        self.walk(ray, limit, stack, &mut visitor);
         visitor.best
     }
 
@@ -45,6 +44,7 @@ impl Octree {
         ray: &PreparedRay,
         t_max: f64,
         found: &mut ShadowCrossings,
+        stack: &mut WalkStack,
         counter: &mut C,
     ) {
         found.clear();
@@ -61,37 +61,68 @@ impl Octree {
             mailbox: Mailbox::new(),
             counter,
         };
-        self.traverse(ray, t_max, &mut visitor);
+        self.walk(ray, t_max, stack, &mut visitor);
     }
 
-    fn traverse<V: LeafVisitor>(&self, ray: &PreparedRay, t_max: f64, visitor: &mut V) {
+    /// The ray's parameter range inside the root cell, clipped to
+    /// `[0, t_max]` (`None` if it misses): the slab test, with components
+    /// treated as parallel inside their slab everywhere or nowhere.
+    #[inline(always)]
+    fn root_range(&self, ray: &PreparedRay, t_max: f64) -> Option<(f64, f64)> {
+        let (lo, hi) = (self.bounds.min.to_array(), self.bounds.max.to_array());
+        let o = ray.ray.origin.to_array();
+        let (mut t0, mut t1) = (0.0f64, t_max);
+        for k in 0..3 {
+            if ray.parallel >> k & 1 == 1 {
+                if o[k] < lo[k] || o[k] > hi[k] {
+                    return None;
+                }
+                continue;
+            }
+            let inv = ray.inv_dir[k];
+            let (mut near, mut far) = ((lo[k] - o[k]) * inv, (hi[k] - o[k]) * inv);
+            if near > far {
+                std::mem::swap(&mut near, &mut far);
+            }
+            t0 = t0.max(near);
+            t1 = t1.min(far);
+            if t0 > t1 {
+                return None;
+            }
+        }
+        Some((t0, t1))
+    }
+
+    /// The traversal: pops cells front to back until the visitor stops or
+    /// nothing further along the ray can matter.
+    #[inline(always)]
+    fn walk<V: LeafVisitor>(
+        &self,
+        ray: &PreparedRay,
+        t_max: f64,
+        stack: &mut WalkStack,
+        visitor: &mut V,
+    ) {
         if self.nodes.is_empty() {
             return;
         }
-        let walk = WalkRay::new(ray);
-        let Some((t0, t1)) = self.bounds.ray_range(&walk.ray, 0.0, t_max) else {
+        let Some((t0, t1)) = self.root_range(ray, t_max) else {
             return;
         };
-        STACK.with_borrow_mut(|stack| {
-            stack.entries[0] = Entry {
-                node: 0,
-                cell: self.root_cell(),
-                t0,
-                t1,
-            };
-            self.walk(&walk, stack, visitor);
-        });
-    }
-
-    /// The traversal proper: pops cells front to back until the visitor
-    /// stops or nothing further along the ray can matter.
-    #[inline(always)]
-    fn walk<V: LeafVisitor>(&self, ray: &WalkRay, stack: &mut Stack, visitor: &mut V) {
-        let (o, d, inv) = (ray.ray.origin, ray.ray.dir, ray.inv_dir);
+        let o = ray.ray.origin.to_array();
+        let inv = ray.inv_dir;
+        let entries = &mut stack.entries;
+        entries[0] = Entry {
+            min: self.bounds.min.to_array(),
+            t0,
+            t1,
+            node: 0,
+            level: 0,
+        };
         let mut top = 1;
         while top > 0 {
             top -= 1;
-            let e = stack.entries[top];
+            let e = entries[top];
             // The stack holds cells in order along the ray, nearest on top:
             // once one starts past the limit, all the others do.
             if e.t0 > visitor.t_limit() {
@@ -108,7 +139,10 @@ impl Octree {
                 }
                 continue;
             }
-            let mid = e.cell.mid();
+            // The children's side: the cell's half, exactly as the build
+            // halves it.
+            let h = self.sides[(e.level + 1) as usize & LEVEL_MASK];
+            let mid = [e.min[0] + h, e.min[1] + h, e.min[2] + h];
             // Parameters of the three mid-planes, and the octant entered at
             // t0: on a plane's upper side once it is crossed going up, or
             // until it is crossed going down. A ray parallel to a plane (or
@@ -117,7 +151,7 @@ impl Octree {
             let mut t_mid = [0.0f64; 3];
             let mut child = 0usize;
             for k in 0..3 {
-                let t = if d[k] == 0.0 {
+                let t = if ray.parallel >> k & 1 == 1 {
                     if o[k] >= mid[k] {
                         f64::NEG_INFINITY
                     } else {
@@ -127,58 +161,65 @@ impl Octree {
                     (mid[k] - o[k]) * inv[k]
                 };
                 t_mid[k] = t;
-                child |= (((t <= e.t0) != ray.negative[k]) as usize) << k;
+                child |= (((t <= e.t0) as u32 ^ (ray.negative >> k & 1)) as usize) << k;
             }
-            // The crossings inside the cell, in increasing t: the children
-            // the ray passes through follow by flipping one bit at each.
-            let mut inside = [0usize; 3];
-            let mut n_inside = 0;
+            // The crossings inside the cell, in increasing t (ties keep
+            // axis order): the children the ray passes through follow by
+            // flipping one bit at each.
+            let mut axes = [0usize; 3];
+            let mut n = 0;
             for (k, &t) in t_mid.iter().enumerate() {
                 if t > e.t0 && t < e.t1 {
-                    inside[n_inside] = k;
-                    n_inside += 1;
+                    axes[n] = k;
+                    n += 1;
                 }
             }
-            // At most three: compare and swap (ties keep axis order).
-            let earlier = |a: usize, b: usize| t_mid[a] > t_mid[b];
-            if n_inside > 1 && earlier(inside[0], inside[1]) {
-                inside.swap(0, 1);
+            if n > 1 && t_mid[axes[0]] > t_mid[axes[1]] {
+                axes.swap(0, 1);
             }
-            if n_inside > 2 {
-                if earlier(inside[1], inside[2]) {
-                    inside.swap(1, 2);
+            if n > 2 {
+                if t_mid[axes[1]] > t_mid[axes[2]] {
+                    axes.swap(1, 2);
                 }
-                if earlier(inside[0], inside[1]) {
-                    inside.swap(0, 1);
+                if t_mid[axes[0]] > t_mid[axes[1]] {
+                    axes.swap(0, 1);
                 }
             }
-            let crossings = &inside[..n_inside];
-            let mut sequence = [(0usize, 0.0f64, 0.0f64); 4];
-            let mut t_start = e.t0;
-            for (i, &k) in crossings.iter().enumerate() {
-                sequence[i] = (child, t_start, t_mid[k]);
-                child ^= 1 << k;
-                t_start = t_mid[k];
+            // Child i of the sequence is entered at times[i] and left at
+            // times[i + 1].
+            let mut children = [child; 4];
+            let mut times = [e.t0, e.t1, e.t1, e.t1, e.t1];
+            for i in 0..n {
+                child ^= 1 << axes[i];
+                children[i + 1] = child;
+                times[i + 1] = t_mid[axes[i]];
             }
-            sequence[n_inside] = (child, t_start, e.t1);
+            times[n + 1] = e.t1;
             // Farthest first, so the nearest is popped next. Empty octants
             // are counted as entered leaves (Havran's measures) but cost
             // nothing else.
             let limit = visitor.t_limit();
             let mask = node.mask();
-            for &(c, ts, te) in sequence[..=n_inside].iter().rev() {
+            for i in (0..=n).rev() {
+                let c = children[i];
                 if mask >> c & 1 == 0 {
-                    if ts <= limit {
+                    if times[i] <= limit {
                         visitor.counter().traversal_step();
                         visitor.counter().leaf_visit();
                     }
                     continue;
                 }
-                stack.entries[top] = Entry {
+                let bit = |k: usize| (c >> k & 1) as f64;
+                entries[top & (STACK_CAPACITY - 1)] = Entry {
+                    min: [
+                        e.min[0] + h * bit(0),
+                        e.min[1] + h * bit(1),
+                        e.min[2] + h * bit(2),
+                    ],
+                    t0: times[i],
+                    t1: times[i + 1],
                     node: node.child(c),
-                    cell: e.cell.child(c),
-                    t0: ts,
-                    t1: te,
+                    level: e.level + 1,
                 };
                 top += 1;
             }
@@ -186,60 +227,36 @@ impl Octree {
     }
 }
 
-/// A cell waiting on the traversal stack, with the ray's parameters at its
-/// entry and exit.
+/// A cell waiting on the traversal stack: its lowest corner, the ray's
+/// parameters at its entry and exit, its node and its level (which gives
+/// its side).
 #[derive(Clone, Copy, Debug, Default)]
 struct Entry {
-    node: u32,
-    cell: Cell,
+    min: [f64; 3],
     t0: f64,
     t1: f64,
+    node: u32,
+    level: u32,
 }
 
-/// Deepest stack a walk needs: each level leaves at most three siblings
-/// waiting, plus the cell being entered.
-const STACK_CAPACITY: usize = 3 * MAX_OCTREE_DEPTH as usize + 4;
+/// Room on the traversal stack: each level leaves at most three siblings
+/// waiting, plus the cell being entered (a power of two, so indices are
+/// masked instead of bounds-checked).
+const STACK_CAPACITY: usize = (3 * MAX_OCTREE_DEPTH as usize + 4).next_power_of_two();
 
-/// The cells a walk has still to visit.
-struct Stack {
+/// Levels the side table holds (masked the same way).
+pub(super) const LEVEL_MASK: usize = (MAX_OCTREE_DEPTH as usize + 2).next_power_of_two() - 1;
+
+/// The cells a walk has still to visit: scratch space the caller owns
+/// (one per tile of the image), so no ray sets it up.
+pub struct WalkStack {
     entries: [Entry; STACK_CAPACITY],
 }
 
-thread_local! {
-    /// One traversal stack per thread, reused by every ray (a traversal
-    /// never starts another on the same thread), so no ray initialises it.
-    static STACK: std::cell::RefCell<Stack> = std::cell::RefCell::new(Stack {
-        entries: [Entry::default(); STACK_CAPACITY],
-    });
-}
-
-/// The ray as the traversal sees it: direction components too small to
-/// invert are treated as exactly zero (parallel to the planes), which moves
-/// the ray by less than the cells' padding over any finite distance.
-struct WalkRay {
-    ray: crate::math::Ray,
-    inv_dir: DVec3,
-    /// Per axis: the direction is negative.
-    negative: [bool; 3],
-}
-
-impl WalkRay {
-    fn new(r: &PreparedRay) -> Self {
-        let mut ray = r.ray;
-        let mut inv_dir = DVec3::ZERO;
-        for k in 0..3 {
-            let inv = 1.0 / ray.dir[k];
-            if inv.is_finite() {
-                inv_dir[k] = inv;
-            } else {
-                ray.dir[k] = 0.0;
-            }
-        }
-        let negative = [ray.dir.x < 0.0, ray.dir.y < 0.0, ray.dir.z < 0.0];
+impl Default for WalkStack {
+    fn default() -> Self {
         Self {
-            ray,
-            inv_dir,
-            negative,
+            entries: [Entry::default(); STACK_CAPACITY],
         }
     }
 }
