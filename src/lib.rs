@@ -33,6 +33,7 @@ pub mod render;
 pub mod scene;
 pub mod settings;
 pub mod shapes;
+pub mod simd;
 pub mod stats;
 #[cfg(feature = "gui")]
 pub mod viewer;

@@ -13,6 +13,9 @@ pub trait Counter {
     /// Adds work counted elsewhere (the cost view counts per pixel).
     #[inline(always)]
     fn add_work(&mut self, _work: &WorkCounts) {}
+    /// The same unit of work for `n` rays of a packet at once.
+    #[inline(always)]
+    fn add_lanes(&mut self, _tests: u32, _steps: u32, _leaves: u32) {}
 }
 
 /// Counts nothing; the default.
@@ -47,6 +50,12 @@ impl Counter for WorkCounts {
     #[inline(always)]
     fn add_work(&mut self, work: &WorkCounts) {
         *self += *work;
+    }
+    #[inline(always)]
+    fn add_lanes(&mut self, tests: u32, steps: u32, leaves: u32) {
+        self.intersection_tests += tests as u64;
+        self.traversal_steps += steps as u64;
+        self.leaves_visited += leaves as u64;
     }
 }
 

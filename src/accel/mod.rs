@@ -7,7 +7,7 @@ mod primitives;
 
 pub use octree::{
     DEFAULT_MEMORY_BUDGET_MIB, Octree, OctreeCell, OctreeError, OctreeParams, OctreeStats,
-    WalkStack,
+    PacketStack, WalkStack,
 };
 pub use primitives::{
     ClosestHit, MAX_SHADOW_CROSSINGS, Primitives, ShadowCrossings, closest_brute_force,

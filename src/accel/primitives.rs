@@ -2,7 +2,8 @@
 //! octree's leaves run, and brute force is, over every shape. Apart from
 //! `mod.rs` so that the octree depends on it and not on its parent.
 
-use crate::shapes::{PreparedRay, Shape, ShapeHit};
+use crate::shapes::{PacketHits, PreparedRay, RayPacket, Shape, ShapeHit};
+use crate::simd::F64s;
 use crate::stats::Counter;
 
 /// The shapes a ray query runs over, and what it must know of each.
@@ -42,6 +43,75 @@ impl<'a> Primitives<'a> {
     #[inline(always)]
     fn is_transparent(&self, index: u32) -> bool {
         self.transparent.get(index as usize) == Some(&true)
+    }
+
+    /// Whether any shape lets light through (shadow rays then record
+    /// crossings one by one instead of stopping at the first hit).
+    pub fn any_transparent(&self) -> bool {
+        self.transparent.contains(&true)
+    }
+
+    /// [`test_closest`] for the `lanes` of a packet: two-sided triangles
+    /// in lanes, other shapes lane by lane.
+    #[inline(always)]
+    pub(crate) fn closest_lanes<C: Counter, const N: usize>(
+        &self,
+        index: u32,
+        p: &RayPacket<N>,
+        lanes: u32,
+        best: &mut PacketHits<N>,
+        counter: &mut C,
+    ) {
+        counter.add_lanes(lanes.count_ones(), 0, 0);
+        let probe = best.probe;
+        match &self.shapes[index as usize] {
+            Shape::Triangle(t) if self.one_sided.get(index as usize) != Some(&true) => {
+                let h = t.intersect_lanes(p, &probe);
+                best.merge(index, h.hit & lanes, h.t, h.b1, h.b2);
+            }
+            _ => {
+                for i in 0..N {
+                    if lanes >> i & 1 == 1
+                        && let Some(hit) = self.intersect(index, &p.rays[i], probe[i])
+                    {
+                        let mut t = best.t;
+                        let (mut b1, mut b2) = (best.b1, best.b2);
+                        (t[i], b1[i], b2[i]) = (hit.t, hit.b1, hit.b2);
+                        best.merge(index, 1 << i, t, b1, b2);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The `lanes` of a packet of shadow rays that shape `index` blocks
+    /// within each lane's `t_max` (for scenes without transparent shapes:
+    /// any hit blocks, as in [`test_occlusion`]).
+    #[inline(always)]
+    pub(crate) fn blocked_lanes<C: Counter, const N: usize>(
+        &self,
+        index: u32,
+        p: &RayPacket<N>,
+        t_max: &F64s<N>,
+        lanes: u32,
+        counter: &mut C,
+    ) -> u32 {
+        counter.add_lanes(lanes.count_ones(), 0, 0);
+        match &self.shapes[index as usize] {
+            Shape::Triangle(t) if self.one_sided.get(index as usize) != Some(&true) => {
+                t.intersect_lanes(p, t_max).hit & lanes
+            }
+            _ => {
+                let mut blocked = 0;
+                for i in 0..N {
+                    if lanes >> i & 1 == 1 && self.intersect(index, &p.rays[i], t_max[i]).is_some()
+                    {
+                        blocked |= 1 << i;
+                    }
+                }
+                blocked
+            }
+        }
     }
 }
 

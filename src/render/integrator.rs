@@ -3,6 +3,7 @@
 //! its shadow ray) and the secondary rays (refraction, then the mirror
 //! ray), each traced recursively to the depth limit (Whitted 1980).
 
+use crate::accel::ClosestHit;
 use crate::math::{Color, DVec3, Ray, offset_ray_origin, reflect, refract};
 use crate::ray_tree::{HitRecord, RayKind, RayRecorder, ShadowRecord, ShadowVerdict};
 use crate::settings::Protocol;
@@ -13,7 +14,7 @@ use super::renderer::{Query, Renderer};
 
 /// A hit resolved for shading: where, which way the surface faces, and
 /// with what material.
-struct ShadingPoint {
+pub(super) struct ShadingPoint {
     point: DVec3,
     /// The geometric normal turned towards the incoming ray.
     facing: DVec3,
@@ -61,6 +62,16 @@ impl Renderer<'_> {
         rec: &mut R,
     ) -> Option<ShadingPoint> {
         let hit = self.closest(&PreparedRay::new(*ray), query)?;
+        Some(self.shading_point_at(ray, &hit, rec))
+    }
+
+    /// The hit `hit` of `ray` resolved for shading, told to `rec`.
+    pub(super) fn shading_point_at<R: RayRecorder>(
+        &self,
+        ray: &Ray,
+        hit: &ClosestHit,
+        rec: &mut R,
+    ) -> ShadingPoint {
         let scene = self.scene;
         let shape = &scene.shapes[hit.shape as usize];
         let surface = shape.surface(ray, &hit.hit, &scene.vertex_normals);
@@ -91,13 +102,13 @@ impl Renderer<'_> {
             normal: normal.to_array(),
             entering,
         });
-        Some(ShadingPoint {
+        ShadingPoint {
             point,
             facing,
             normal,
             entering,
             material,
-        })
+        }
     }
 
     /// The local term at `at`: ambient light plus, for every light the
@@ -111,42 +122,13 @@ impl Renderer<'_> {
         rays: &mut RayCounts,
         rec: &mut R,
     ) -> Color {
-        let scene = self.scene;
-        let material = &self.materials[at.material as usize];
-        let n = at.normal;
-        let view = -ray.dir;
-        let mut color = material.ka * scene.image.ambient * material.color;
-        let shadow_origin = offset_ray_origin(at.point, at.facing, self.floor_scale);
-        for (index, light) in scene.lights.iter().enumerate() {
-            let verdict = |verdict, transmittance, color: Color| ShadowRecord {
-                light: index,
-                verdict,
-                transmittance,
-                color: color.to_array(),
-            };
-            let to_light = light.position - shadow_origin;
-            let distance = to_light.length();
-            if !(distance > 0.0) {
-                rec.light(index, false);
-                rec.shadow(|| verdict(ShadowVerdict::FacesAway, 0.0, Color::ZERO));
+        let mut color = self.ambient(at);
+        let shadow_origin = self.shadow_origin(at);
+        for (index, light) in self.scene.lights.iter().enumerate() {
+            let Some((l, distance, n_dot_l)) = self.toward_light(at, shadow_origin, light) else {
+                self.faces_away(index, rec);
                 continue;
-            }
-            let l = to_light / distance;
-            let n_dot_l = n.dot(l);
-            // A surface facing away from the light gets neither light nor a
-            // shadow ray. glint asks both normals: an interpolated normal can
-            // face the light where the surface itself does not. The SPD
-            // asks the shading normal alone (its published shadow counts on
-            // the smooth-shaded teapot match only that way).
-            let faces_away = match self.settings.protocol {
-                Protocol::Glint => n_dot_l <= 0.0 || at.facing.dot(l) <= 0.0,
-                Protocol::Spd => n_dot_l <= 0.0,
             };
-            if faces_away {
-                rec.light(index, false);
-                rec.shadow(|| verdict(ShadowVerdict::FacesAway, 0.0, Color::ZERO));
-                continue;
-            }
             let pass = if self.settings.shadows {
                 rays.shadow += 1;
                 let shadow = PreparedRay::new(Ray::new(shadow_origin, l));
@@ -154,38 +136,121 @@ impl Renderer<'_> {
             } else {
                 1.0
             };
-            rec.light(index, pass > 0.0);
-            if pass == 0.0 {
-                rec.shadow(|| verdict(ShadowVerdict::Blocked, 0.0, Color::ZERO));
-                continue;
+            if let Some(direct) = self.light_through(ray, at, index, l, n_dot_l, pass, rec) {
+                color += direct;
             }
-            let diffuse = material.kd * n_dot_l * material.color;
-            // Without a highlight the Phong term is exactly 0 (its power is
-            // at most 1): skip the power, the costliest step of shading.
-            let specular = if material.ks == 0.0 {
-                0.0
-            } else {
-                let r = 2.0 * n_dot_l * n - l;
-                material.ks * r.dot(view).max(0.0).powf(material.shininess)
-            };
-            let direct = (diffuse + DVec3::splat(specular)) * light.color * pass;
-            rec.shadow(|| {
-                let kind = if pass < 1.0 {
-                    ShadowVerdict::Attenuated
-                } else {
-                    ShadowVerdict::Lit
-                };
-                verdict(kind, pass, direct)
-            });
-            color += direct;
         }
         color
+    }
+
+    /// The ambient term at `at`.
+    #[inline(always)]
+    pub(super) fn ambient(&self, at: &ShadingPoint) -> Color {
+        let material = &self.materials[at.material as usize];
+        material.ka * self.scene.image.ambient * material.color
+    }
+
+    /// Where shadow rays from `at` start: off the surface on the side the
+    /// ray came from.
+    #[inline(always)]
+    pub(super) fn shadow_origin(&self, at: &ShadingPoint) -> DVec3 {
+        offset_ray_origin(at.point, at.facing, self.floor_scale)
+    }
+
+    /// The direction to `light` from `origin`, its distance and the cosine
+    /// at the surface; `None` where the surface faces away from the light
+    /// (or the light sits on the origin): then it gets neither light nor a
+    /// shadow ray. glint asks both normals: an interpolated normal can face
+    /// the light where the surface itself does not. The SPD asks the shading
+    /// normal alone (its published shadow counts on the smooth-shaded
+    /// teapot match only that way).
+    #[inline(always)]
+    pub(super) fn toward_light(
+        &self,
+        at: &ShadingPoint,
+        origin: DVec3,
+        light: &crate::material::Light,
+    ) -> Option<(DVec3, f64, f64)> {
+        let to_light = light.position - origin;
+        let distance = to_light.length();
+        if !(distance > 0.0) {
+            return None;
+        }
+        let l = to_light / distance;
+        let n_dot_l = at.normal.dot(l);
+        let faces_away = match self.settings.protocol {
+            Protocol::Glint => n_dot_l <= 0.0 || at.facing.dot(l) <= 0.0,
+            Protocol::Spd => n_dot_l <= 0.0,
+        };
+        (!faces_away).then_some((l, distance, n_dot_l))
+    }
+
+    /// Tells `rec` that light `index` faces away from the point.
+    #[inline(always)]
+    pub(super) fn faces_away<R: RayRecorder>(&self, index: usize, rec: &mut R) {
+        rec.light(index, false);
+        rec.shadow(|| ShadowRecord {
+            light: index,
+            verdict: ShadowVerdict::FacesAway,
+            transmittance: 0.0,
+            color: [0.0; 3],
+        });
+    }
+
+    /// Light `index`'s diffuse and specular terms at `at` (direction `l`,
+    /// cosine `n_dot_l`) times `pass`, the share its shadow ray let
+    /// through; `None` when it let nothing through. Tells `rec`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    pub(super) fn light_through<R: RayRecorder>(
+        &self,
+        ray: &Ray,
+        at: &ShadingPoint,
+        index: usize,
+        l: DVec3,
+        n_dot_l: f64,
+        pass: f64,
+        rec: &mut R,
+    ) -> Option<Color> {
+        let verdict = |verdict, transmittance, color: Color| ShadowRecord {
+            light: index,
+            verdict,
+            transmittance,
+            color: color.to_array(),
+        };
+        rec.light(index, pass > 0.0);
+        if pass == 0.0 {
+            rec.shadow(|| verdict(ShadowVerdict::Blocked, 0.0, Color::ZERO));
+            return None;
+        }
+        let material = &self.materials[at.material as usize];
+        let n = at.normal;
+        let light = &self.scene.lights[index];
+        let diffuse = material.kd * n_dot_l * material.color;
+        // Without a highlight the Phong term is exactly 0 (its power is
+        // at most 1): skip the power, the costliest step of shading.
+        let specular = if material.ks == 0.0 {
+            0.0
+        } else {
+            let r = 2.0 * n_dot_l * n - l;
+            material.ks * r.dot(-ray.dir).max(0.0).powf(material.shininess)
+        };
+        let direct = (diffuse + DVec3::splat(specular)) * light.color * pass;
+        rec.shadow(|| {
+            let kind = if pass < 1.0 {
+                ShadowVerdict::Attenuated
+            } else {
+                ShadowVerdict::Lit
+            };
+            verdict(kind, pass, direct)
+        });
+        Some(direct)
     }
 
     /// Adds what the refracted and the mirror ray from `at` see, each
     /// weighted by the material, to `color`.
     #[allow(clippy::too_many_arguments)]
-    fn secondary_rays<C: Counter, R: RayRecorder>(
+    pub(super) fn secondary_rays<C: Counter, R: RayRecorder>(
         &self,
         ray: &Ray,
         at: &ShadingPoint,

@@ -11,6 +11,7 @@ pub mod adaptive;
 mod corners;
 mod integrator;
 pub mod memory;
+mod packets;
 mod passes;
 mod sampling;
 pub mod tiles;

@@ -15,6 +15,7 @@ use crate::ray_tree::{RayKind, RayNode};
 use crate::scene::Scene;
 use crate::settings::{RenderSettings, Sides, ViewMode};
 use crate::shapes::PreparedRay;
+use crate::simd::SimdLevel;
 use crate::stats::{Counter, NoCounts, RayCounts};
 
 #[derive(Debug, thiserror::Error)]
@@ -61,7 +62,7 @@ const SAME_SURFACE_RELATIVE: f64 = 1e-9;
 /// A scene prepared for rendering with fixed settings.
 pub struct Renderer<'a> {
     pub(super) scene: &'a Scene,
-    octree: &'a Octree,
+    pub(super) octree: &'a Octree,
     pub(super) settings: RenderSettings,
     pub(super) camera: Camera,
     /// Where in a pixel the rays of the full grid pass (the aa-need view
@@ -76,6 +77,10 @@ pub struct Renderer<'a> {
     pub(super) background: Color,
     /// Magnitude of the scene's surfaces and the eye: the floor of ray offsets.
     pub(super) floor_scale: f64,
+    /// Packets of this many lanes where rays are coherent (1: single rays).
+    pub(super) simd: SimdLevel,
+    /// Whether any shape lets light through (shadow packets need none).
+    pub(super) any_transparent: bool,
 }
 
 impl<'a> Renderer<'a> {
@@ -120,7 +125,9 @@ impl<'a> Renderer<'a> {
                 ..m.clone()
             })
             .collect();
+        let any_transparent = is_transparent.contains(&true);
         Ok(Self {
+            any_transparent,
             scene,
             octree,
             settings,
@@ -139,6 +146,7 @@ impl<'a> Renderer<'a> {
                 .grow(camera.eye)
                 .max_abs()
                 .max(f64::MIN_POSITIVE),
+            simd: SimdLevel::current(),
         })
     }
 
@@ -150,7 +158,20 @@ impl<'a> Renderer<'a> {
         &self.camera
     }
 
-    fn primitives(&self) -> Primitives<'_> {
+    /// Renders with packets at `level` instead of the machine's best (at
+    /// most the best: a level the machine lacks runs its best). The bytes
+    /// are the same at every level; only the time differs.
+    pub fn with_simd(mut self, level: SimdLevel) -> Self {
+        self.simd = level.min(SimdLevel::best());
+        self
+    }
+
+    /// The SIMD level this render uses.
+    pub fn simd(&self) -> SimdLevel {
+        self.simd
+    }
+
+    pub(super) fn primitives(&self) -> Primitives<'_> {
         Primitives {
             shapes: &self.scene.shapes,
             one_sided: &self.one_sided,

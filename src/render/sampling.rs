@@ -45,6 +45,15 @@ impl Renderer<'_> {
     /// `count_work` (tracing is generic over the counter, so the other
     /// case costs nothing). The tile's rays share one scratch space.
     pub(super) fn run_tile(&self, job: TileJob, tile: Tile, count_work: bool) -> TileOutput {
+        if self.uses_packets() {
+            let packets = super::packets::PacketTile {
+                renderer: self,
+                job,
+                tile,
+                count_work,
+            };
+            return crate::simd::dispatch(self.simd, packets);
+        }
         let mut out = TileOutput {
             values: Vec::with_capacity(tile.pixels()),
             signatures: Vec::new(),
@@ -180,8 +189,19 @@ impl Renderer<'_> {
 
     /// One sample of a non-shaded view for the eye ray `ray`.
     fn inspect<C: Counter>(&self, ray: &Ray, query: &mut Query<C>, rays: &mut RayCounts) -> DVec3 {
-        let prepared = PreparedRay::new(*ray);
-        let Some(hit) = self.closest(&prepared, query) else {
+        let hit = self.closest(&PreparedRay::new(*ray), query);
+        self.inspect_hit(ray, hit.as_ref(), rays)
+    }
+
+    /// The non-shaded view's value for the eye ray `ray` that met `hit`.
+    #[inline(always)]
+    pub(super) fn inspect_hit(
+        &self,
+        ray: &Ray,
+        hit: Option<&crate::accel::ClosestHit>,
+        rays: &mut RayCounts,
+    ) -> DVec3 {
+        let Some(hit) = hit else {
             return DVec3::ZERO;
         };
         rays.primary_hits += 1;

@@ -3,6 +3,7 @@
 
 mod cone;
 mod hit;
+mod packet;
 mod plane;
 mod quadric;
 mod sphere;
@@ -10,6 +11,7 @@ mod triangle;
 
 pub use cone::Cone;
 pub use hit::{Crossings, PreparedRay, ShapeHit, Surface};
+pub use packet::{LaneHits, PacketHits, RayPacket};
 pub use plane::Plane;
 pub use quadric::Quadric;
 pub use sphere::Sphere;

@@ -27,10 +27,12 @@
 
 mod build;
 mod node;
+mod packet_walk;
 mod params;
 mod tree;
 mod walk;
 
+pub use packet_walk::PacketStack;
 pub use params::{DEFAULT_MEMORY_BUDGET_MIB, OctreeCell, OctreeError, OctreeParams, OctreeStats};
 pub use tree::Octree;
 pub use walk::WalkStack;

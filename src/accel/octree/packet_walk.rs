@@ -1,0 +1,348 @@
+//! The traversal for packets of coherent rays (Knoll, Hansen & Wald 2007
+//! walk packets through octrees; here with Revelles' parametric cells). A
+//! packet's lanes share their direction's signs, so every lane meets an
+//! interior node's children in the same order: by how many of its planes
+//! separate them from the near corner (0, then 1, 2, 3). A single ray passes
+//! through at most one child of each rank, one rank after the other, so
+//! that fixed order is front to back for every lane. Each lane keeps its own
+//! interval in each cell and its own closest hit; a cell is visited while
+//! any lane is inside it before its limit, and a lane's answer is exactly
+//! the single ray's (the closest hit is the lexicographic minimum of
+//! `(t, shape index)` whatever the order of the tests).
+
+use super::super::primitives::Primitives;
+use super::tree::Octree;
+use super::walk::LEVEL_MASK;
+use crate::limits::MAX_OCTREE_DEPTH;
+use crate::shapes::{PacketHits, RayPacket};
+use crate::simd::{F64s, mask, max, min, open_before};
+use crate::stats::Counter;
+
+/// A cell waiting on a packet's stack: its corner, node and level, and
+/// each lane's parameters at its entry and exit (empty where the lane's
+/// ray misses it).
+#[derive(Clone, Copy, Debug)]
+pub struct PacketEntry<const N: usize> {
+    min: [f64; 3],
+    t0: F64s<N>,
+    t1: F64s<N>,
+    node: u32,
+    level: u32,
+}
+
+impl<const N: usize> Default for PacketEntry<N> {
+    fn default() -> Self {
+        Self {
+            min: [0.0; 3],
+            t0: [0.0; N],
+            t1: [0.0; N],
+            node: 0,
+            level: 0,
+        }
+    }
+}
+
+/// Room on a packet's stack: each level may leave seven siblings waiting,
+/// plus the cell being entered.
+pub const PACKET_STACK_CAPACITY: usize = 7 * MAX_OCTREE_DEPTH as usize + 8;
+
+/// The cells a packet has still to visit: scratch space the caller owns
+/// (allocated once, never cleared: entries are written before they are
+/// read).
+pub struct PacketStack<const N: usize> {
+    entries: Vec<PacketEntry<N>>,
+}
+
+impl<const N: usize> Default for PacketStack<N> {
+    fn default() -> Self {
+        Self {
+            entries: Vec::with_capacity(PACKET_STACK_CAPACITY),
+        }
+    }
+}
+
+/// What a packet's walk does at its leaves.
+trait PacketVisitor<const N: usize> {
+    /// Tests the shape `index` in `lanes`.
+    fn test(&mut self, index: u32, lanes: u32);
+    /// Each lane's limit: cells starting beyond it cannot change its answer.
+    fn limit(&self) -> F64s<N>;
+    fn counter(&mut self) -> &mut impl Counter;
+}
+
+struct Closest<'a, C, const N: usize> {
+    prims: &'a Primitives<'a>,
+    packet: &'a RayPacket<N>,
+    best: PacketHits<N>,
+    counter: &'a mut C,
+}
+
+impl<C: Counter, const N: usize> PacketVisitor<N> for Closest<'_, C, N> {
+    #[inline(always)]
+    fn test(&mut self, index: u32, lanes: u32) {
+        self.prims
+            .closest_lanes(index, self.packet, lanes, &mut self.best, self.counter);
+    }
+    #[inline(always)]
+    fn limit(&self) -> F64s<N> {
+        self.best.t
+    }
+    #[inline(always)]
+    fn counter(&mut self) -> &mut impl Counter {
+        self.counter
+    }
+}
+
+struct Blocked<'a, C, const N: usize> {
+    prims: &'a Primitives<'a>,
+    packet: &'a RayPacket<N>,
+    t_max: F64s<N>,
+    /// Lanes an opaque shape blocks; their limit drops below every cell.
+    blocked: u32,
+    counter: &'a mut C,
+}
+
+impl<C: Counter, const N: usize> PacketVisitor<N> for Blocked<'_, C, N> {
+    #[inline(always)]
+    fn test(&mut self, index: u32, lanes: u32) {
+        let lanes = lanes & !self.blocked;
+        if lanes != 0 {
+            self.blocked |=
+                self.prims
+                    .blocked_lanes(index, self.packet, &self.t_max, lanes, self.counter);
+        }
+    }
+    #[inline(always)]
+    fn limit(&self) -> F64s<N> {
+        std::array::from_fn(|i| {
+            if self.blocked >> i & 1 == 1 {
+                f64::NEG_INFINITY
+            } else {
+                self.t_max[i]
+            }
+        })
+    }
+    #[inline(always)]
+    fn counter(&mut self) -> &mut impl Counter {
+        self.counter
+    }
+}
+
+/// Remembers, for the last shapes tested, the lanes they were tested in
+/// (direct-mapped, 16 entries), so a shape referenced from several leaves
+/// is tested once per lane, as the single-ray mailbox does.
+struct LaneMailbox([(u32, u32); 16]);
+
+impl LaneMailbox {
+    /// The lanes of `lanes` in which `index` is not yet tested; records them.
+    #[inline(always)]
+    fn untested(&mut self, index: u32, lanes: u32) -> u32 {
+        let slot = &mut self.0[(index & 15) as usize];
+        if slot.0 == index {
+            let fresh = lanes & !slot.1;
+            slot.1 |= fresh;
+            fresh
+        } else {
+            *slot = (index, lanes);
+            lanes
+        }
+    }
+}
+
+impl Octree {
+    /// Each lane's closest hit with `0 < t < t_max[lane]`, as
+    /// [`Octree::closest`] finds it for the lane's ray alone.
+    #[inline(always)]
+    pub fn closest_packet<C: Counter, const N: usize>(
+        &self,
+        prims: &Primitives,
+        packet: &RayPacket<N>,
+        t_max: F64s<N>,
+        stack: &mut PacketStack<N>,
+        counter: &mut C,
+    ) -> PacketHits<N> {
+        let mut visitor = Closest {
+            prims,
+            packet,
+            best: PacketHits::new(t_max),
+            counter,
+        };
+        for &i in &self.unbounded {
+            visitor.test(i, packet.live);
+        }
+        self.walk_packet(packet, stack, &mut visitor);
+        visitor.best
+    }
+
+    /// The lanes whose shadow ray an opaque shape blocks within `t_max`
+    /// (for scenes without transparent shapes).
+    #[inline(always)]
+    pub fn blocked_packet<C: Counter, const N: usize>(
+        &self,
+        prims: &Primitives,
+        packet: &RayPacket<N>,
+        t_max: F64s<N>,
+        stack: &mut PacketStack<N>,
+        counter: &mut C,
+    ) -> u32 {
+        let mut visitor = Blocked {
+            prims,
+            packet,
+            t_max,
+            blocked: 0,
+            counter,
+        };
+        for &i in &self.unbounded {
+            visitor.test(i, packet.live);
+        }
+        self.walk_packet(packet, stack, &mut visitor);
+        visitor.blocked
+    }
+
+    #[inline(always)]
+    fn walk_packet<V: PacketVisitor<N>, const N: usize>(
+        &self,
+        p: &RayPacket<N>,
+        stack: &mut PacketStack<N>,
+        visitor: &mut V,
+    ) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let (lo, hi) = (self.bounds.min.to_array(), self.bounds.max.to_array());
+        let (o, inv) = (&p.origin, &p.inv_dir);
+        // The root's slab test in each lane, as the single ray's.
+        let limit = visitor.limit();
+        let mut t0 = [0.0f64; N];
+        let mut t1 = limit;
+        for k in 0..3 {
+            let mut near: F64s<N> = std::array::from_fn(|i| (lo[k] - o[k][i]) * inv[k][i]);
+            let mut far: F64s<N> = std::array::from_fn(|i| (hi[k] - o[k][i]) * inv[k][i]);
+            if p.negative >> k & 1 == 1 {
+                std::mem::swap(&mut near, &mut far);
+            }
+            t0 = max(t0, near);
+            t1 = min(t1, far);
+        }
+        if mask(t0, t1, |a, b| a <= b) & p.live == 0 {
+            return;
+        }
+        let entries = &mut stack.entries;
+        entries.clear();
+        entries.push(PacketEntry {
+            min: lo,
+            t0,
+            t1,
+            node: 0,
+            level: 0,
+        });
+        let mut mailbox = LaneMailbox([(u32::MAX, 0); 16]);
+        while let Some(e) = entries.pop() {
+            let limit = visitor.limit();
+            let active = open_before(e.t0, e.t1, limit) & p.live;
+            if active == 0 {
+                continue;
+            }
+            let lanes = active.count_ones();
+            let node = self.nodes[e.node as usize];
+            if node.is_leaf() {
+                visitor.counter().add_lanes(0, lanes, lanes);
+                let first = node.first as usize;
+                for &index in &self.refs[first..first + node.count() as usize] {
+                    let fresh = mailbox.untested(index, active);
+                    if fresh != 0 {
+                        visitor.test(index, fresh);
+                    }
+                }
+                continue;
+            }
+            visitor.counter().add_lanes(0, lanes, 0);
+            let h = self.sides[(e.level + 1) as usize & LEVEL_MASK];
+            let mid = [e.min[0] + h, e.min[1] + h, e.min[2] + h];
+            let t_mid: [F64s<N>; 3] =
+                std::array::from_fn(|k| std::array::from_fn(|i| (mid[k] - o[k][i]) * inv[k][i]));
+            let cell = Cell {
+                e: &e,
+                h,
+                t_mid: &t_mid,
+                limit: &limit,
+                active,
+                negative: p.negative,
+                node_mask: node.mask(),
+                first_child: node,
+            };
+            // The octants by their far bits (those past a mid-plane along
+            // the rays), farthest first, so the nearest is popped next.
+            cell.push::<7, _>(entries, visitor);
+            cell.push::<3, _>(entries, visitor);
+            cell.push::<5, _>(entries, visitor);
+            cell.push::<6, _>(entries, visitor);
+            cell.push::<1, _>(entries, visitor);
+            cell.push::<2, _>(entries, visitor);
+            cell.push::<4, _>(entries, visitor);
+            cell.push::<0, _>(entries, visitor);
+        }
+    }
+}
+
+/// An interior cell being split for a packet.
+struct Cell<'a, const N: usize> {
+    e: &'a PacketEntry<N>,
+    /// The children's side.
+    h: f64,
+    /// Each lane's parameter at the three mid-planes.
+    t_mid: &'a [F64s<N>; 3],
+    limit: &'a F64s<N>,
+    active: u32,
+    negative: u32,
+    node_mask: u32,
+    first_child: super::node::Node,
+}
+
+impl<const N: usize> Cell<'_, N> {
+    /// Pushes the child whose far bits are `FAR` (bit k: past the mid-plane
+    /// of axis k along the rays) if a lane enters it before its limit: past
+    /// a mid-plane the child starts where the ray crosses it; before it, it
+    /// ends there.
+    #[inline(always)]
+    fn push<const FAR: u32, V: PacketVisitor<N>>(
+        &self,
+        entries: &mut Vec<PacketEntry<N>>,
+        visitor: &mut V,
+    ) {
+        let mut c0 = self.e.t0;
+        let mut c1 = self.e.t1;
+        for k in 0..3 {
+            if FAR >> k & 1 == 1 {
+                c0 = max(c0, self.t_mid[k]);
+            } else {
+                c1 = min(c1, self.t_mid[k]);
+            }
+        }
+        let inside = open_before(c0, c1, *self.limit) & self.active;
+        if inside == 0 {
+            return;
+        }
+        let c = (FAR ^ self.negative) as usize & 7;
+        if self.node_mask >> c & 1 == 0 {
+            // An empty octant: entered (Havran's measures count it),
+            // nothing to test.
+            let n = inside.count_ones();
+            visitor.counter().add_lanes(0, n, n);
+            return;
+        }
+        let (e, h) = (self.e, self.h);
+        let bit = |k: usize| (c >> k & 1) as f64;
+        entries.push(PacketEntry {
+            min: [
+                e.min[0] + h * bit(0),
+                e.min[1] + h * bit(1),
+                e.min[2] + h * bit(2),
+            ],
+            t0: c0,
+            t1: c1,
+            node: self.first_child.child(c),
+            level: e.level + 1,
+        });
+    }
+}

@@ -1,0 +1,386 @@
+//! Tiles traced in packets: the eye rays of neighbouring pixels (or a
+//! pixel's samples, or neighbouring corners) walk the octree together,
+//! and the shadow rays of their hits towards one light do too. Each lane
+//! is then shaded by the same code, operation for operation, as a single
+//! ray: the pixels are the single-ray path's, byte for byte, at every SIMD
+//! level. Secondary rays (reflection, refraction) go one by one: they
+//! scatter. Packets need coherent rays (one sign pattern and axis
+//! permutation, none parallel to an axis plane); any other group falls back
+//! to single rays, lane by lane.
+
+use crate::accel::{ClosestHit, PacketStack};
+use crate::math::{Color, DVec3, Ray};
+use crate::ray_tree::{NoRecord, RayRecorder};
+use crate::shapes::{PacketHits, PreparedRay, RayPacket, ShapeHit};
+use crate::simd::{LaneWork, splat};
+use crate::stats::{Counter, NoCounts, RayCounts, RenderCounts, WorkCounts};
+
+use super::adaptive::Signature;
+use super::integrator::ShadingPoint;
+use super::renderer::{Query, Renderer, Scratch};
+use super::sampling::{PixelSum, TileJob, TileOutput};
+use super::tiles::Tile;
+
+/// A tile's job, run by [`crate::simd::dispatch`] with the level's lanes.
+pub(super) struct PacketTile<'r, 'a> {
+    pub renderer: &'r Renderer<'a>,
+    pub job: TileJob<'r>,
+    pub tile: Tile,
+    pub count_work: bool,
+}
+
+impl LaneWork for PacketTile<'_, '_> {
+    type Output = TileOutput;
+
+    #[inline(always)]
+    fn run<const N: usize>(self) -> TileOutput {
+        let mut out = TileOutput {
+            values: Vec::with_capacity(self.tile.pixels()),
+            signatures: Vec::new(),
+            counts: RenderCounts::default(),
+        };
+        let mut scratch = Scratch::default();
+        let mut stack = PacketStack::<N>::default();
+        let r = self.renderer;
+        if self.count_work {
+            let mut work = WorkCounts::default();
+            let mut query = Query {
+                counter: &mut work,
+                scratch: &mut scratch,
+            };
+            r.fill_tile_lanes::<_, N>(self.job, self.tile, &mut query, &mut stack, &mut out);
+            out.counts.work = work;
+        } else {
+            let mut query = Query {
+                counter: &mut NoCounts,
+                scratch: &mut scratch,
+            };
+            r.fill_tile_lanes::<_, N>(self.job, self.tile, &mut query, &mut stack, &mut out);
+        }
+        out
+    }
+}
+
+impl Renderer<'_> {
+    /// Whether this render traces packets: a SIMD level with lanes, and a
+    /// view that does not count each ray's own work (the cost views trace
+    /// ray by ray).
+    pub(super) fn uses_packets(&self) -> bool {
+        self.simd.lanes() > 1 && !self.settings.view.is_cost()
+    }
+
+    /// [`Renderer::run_tile`]'s work, in packets of `N` eye rays.
+    #[inline(always)]
+    fn fill_tile_lanes<C: Counter, const N: usize>(
+        &self,
+        job: TileJob,
+        tile: Tile,
+        query: &mut Query<C>,
+        stack: &mut PacketStack<N>,
+        out: &mut TileOutput,
+    ) {
+        let width = self.settings.width;
+        let view = self.settings.view;
+        match job {
+            TileJob::Centre { signatures } => {
+                for j in tile.y..tile.y + tile.height {
+                    let mut i = tile.x;
+                    while i < tile.x + tile.width {
+                        let n = N.min((tile.x + tile.width - i) as usize);
+                        let rays: [Ray; N] =
+                            std::array::from_fn(|k| self.camera.ray(i + k as u32, j, 0.5, 0.5));
+                        let values = if signatures {
+                            let mut recs = [Signature::default(); N];
+                            let v = self.sample_lanes(
+                                &rays[..n],
+                                query,
+                                stack,
+                                &mut out.counts,
+                                &mut recs,
+                            );
+                            out.signatures.extend(recs[..n].iter().map(|s| s.value));
+                            v
+                        } else {
+                            let mut recs = [NoRecord; N];
+                            self.sample_lanes(&rays[..n], query, stack, &mut out.counts, &mut recs)
+                        };
+                        for v in &values[..n] {
+                            let mut pixel = PixelSum::default();
+                            pixel.add(*v);
+                            out.values.push(pixel.value(view, true));
+                        }
+                        i += n as u32;
+                    }
+                }
+            }
+            TileJob::Corners => {
+                for j in tile.y..tile.y + tile.height {
+                    let mut i = tile.x;
+                    while i < tile.x + tile.width {
+                        let n = N.min((tile.x + tile.width - i) as usize);
+                        let rays: [Ray; N] =
+                            std::array::from_fn(|k| self.camera.ray(i + k as u32, j, 0.0, 0.0));
+                        let mut recs = [NoRecord; N];
+                        let values =
+                            self.sample_lanes(&rays[..n], query, stack, &mut out.counts, &mut recs);
+                        out.values.extend_from_slice(&values[..n]);
+                        i += n as u32;
+                    }
+                }
+            }
+            TileJob::Grid | TileJob::Refine { .. } => {
+                for (i, j) in tile.coordinates() {
+                    let value = match job {
+                        TileJob::Refine { first, mask } if !mask[(j * width + i) as usize] => {
+                            first[(j * width + i) as usize]
+                        }
+                        _ => {
+                            if matches!(job, TileJob::Refine { .. }) {
+                                out.counts.refined_pixels += 1;
+                            }
+                            self.grid_pixel_lanes(i, j, query, stack, &mut out.counts)
+                        }
+                    };
+                    out.values.push(value);
+                }
+            }
+        }
+    }
+
+    /// Pixel `(i, j)` from its full grid of samples, traced `N` at a time
+    /// and summed in the grid's order.
+    #[inline(always)]
+    fn grid_pixel_lanes<C: Counter, const N: usize>(
+        &self,
+        i: u32,
+        j: u32,
+        query: &mut Query<C>,
+        stack: &mut PacketStack<N>,
+        counts: &mut RenderCounts,
+    ) -> DVec3 {
+        let mut pixel = PixelSum::default();
+        for chunk in self.grid.chunks(N) {
+            let rays: [Ray; N] = std::array::from_fn(|k| {
+                let (dx, dy) = chunk[k.min(chunk.len() - 1)];
+                self.camera.ray(i, j, dx, dy)
+            });
+            let mut recs = [NoRecord; N];
+            let values = self.sample_lanes(&rays[..chunk.len()], query, stack, counts, &mut recs);
+            for v in &values[..chunk.len()] {
+                pixel.add(*v);
+            }
+        }
+        pixel.value(self.settings.view, true)
+    }
+
+    /// [`Renderer::sample`] for each of `rays` (at most `N`), with their
+    /// recorders `recs`.
+    #[inline(always)]
+    fn sample_lanes<C: Counter, R: RayRecorder, const N: usize>(
+        &self,
+        rays: &[Ray],
+        query: &mut Query<C>,
+        stack: &mut PacketStack<N>,
+        counts: &mut RenderCounts,
+        recs: &mut [R; N],
+    ) -> [DVec3; N] {
+        counts.rays.primary += rays.len() as u64;
+        let prepared: [PreparedRay; N] =
+            std::array::from_fn(|k| PreparedRay::new(rays[k.min(rays.len() - 1)]));
+        let prepared = &prepared[..rays.len()];
+        let hits = self.closest_lanes::<C, N>(prepared, query, stack);
+        let mut values = if self.settings.view.traces_shading() {
+            self.shade_lanes(rays, &hits, query, stack, &mut counts.rays, recs)
+        } else {
+            std::array::from_fn(|k| {
+                if k < rays.len() {
+                    self.inspect_hit(&rays[k], hits[k].as_ref(), &mut counts.rays)
+                } else {
+                    DVec3::ZERO
+                }
+            })
+        };
+        for v in values.iter_mut().take(rays.len()) {
+            if !v.is_finite() {
+                counts.nonfinite_samples += 1;
+                *v = DVec3::ZERO;
+            }
+        }
+        values
+    }
+
+    /// Each ray's closest hit: as a packet through the octree where the
+    /// rays allow, one by one otherwise.
+    #[inline(always)]
+    fn closest_lanes<C: Counter, const N: usize>(
+        &self,
+        rays: &[PreparedRay],
+        query: &mut Query<C>,
+        stack: &mut PacketStack<N>,
+    ) -> [Option<ClosestHit>; N] {
+        if self.settings.use_octree
+            && let Some(packet) = RayPacket::<N>::new(rays)
+        {
+            let prims = self.primitives();
+            let best = self.octree.closest_packet(
+                &prims,
+                &packet,
+                splat(f64::INFINITY),
+                stack,
+                query.counter,
+            );
+            return std::array::from_fn(|k| {
+                (k < rays.len() && best.shape[k] != PacketHits::<N>::NONE).then(|| ClosestHit {
+                    shape: best.shape[k],
+                    hit: ShapeHit {
+                        t: best.t[k],
+                        b1: best.b1[k],
+                        b2: best.b2[k],
+                    },
+                })
+            });
+        }
+        std::array::from_fn(|k| {
+            if k < rays.len() {
+                self.closest(&rays[k], query)
+            } else {
+                None
+            }
+        })
+    }
+
+    /// The colours of eye rays that met `hits`: what
+    /// [`Renderer::trace`] computes for each at depth 1, with the shadow
+    /// rays of the hits towards each light traced together.
+    #[inline(always)]
+    fn shade_lanes<C: Counter, R: RayRecorder, const N: usize>(
+        &self,
+        rays: &[Ray],
+        hits: &[Option<ClosestHit>; N],
+        query: &mut Query<C>,
+        stack: &mut PacketStack<N>,
+        ray_counts: &mut RayCounts,
+        recs: &mut [R; N],
+    ) -> [Color; N] {
+        let n = rays.len();
+        let mut colors = [Color::ZERO; N];
+        let mut points: [Option<ShadingPoint>; N] = [const { None }; N];
+        for k in 0..n {
+            match &hits[k] {
+                None => {
+                    colors[k] = self.background;
+                    recs[k].local(colors[k]);
+                    recs[k].finish(colors[k]);
+                }
+                Some(hit) => {
+                    ray_counts.primary_hits += 1;
+                    let at = self.shading_point_at(&rays[k], hit, &mut recs[k]);
+                    colors[k] = self.ambient(&at);
+                    points[k] = Some(at);
+                }
+            }
+        }
+        let origins: [DVec3; N] = std::array::from_fn(|k| {
+            points[k]
+                .as_ref()
+                .map_or(DVec3::ZERO, |at| self.shadow_origin(at))
+        });
+        for (index, light) in self.scene.lights.iter().enumerate() {
+            let toward: [Option<(DVec3, f64, f64)>; N] = std::array::from_fn(|k| {
+                points[k]
+                    .as_ref()
+                    .and_then(|at| self.toward_light(at, origins[k], light))
+            });
+            let passes = if self.settings.shadows {
+                self.transmittance_lanes(&origins, &toward, query, stack, ray_counts)
+            } else {
+                [1.0; N]
+            };
+            for k in 0..n {
+                let Some(at) = &points[k] else { continue };
+                match toward[k] {
+                    None => self.faces_away(index, &mut recs[k]),
+                    Some((l, _, n_dot_l)) => {
+                        if let Some(direct) = self.light_through(
+                            &rays[k],
+                            at,
+                            index,
+                            l,
+                            n_dot_l,
+                            passes[k],
+                            &mut recs[k],
+                        ) {
+                            colors[k] += direct;
+                        }
+                    }
+                }
+            }
+        }
+        for k in 0..n {
+            let Some(at) = &points[k] else { continue };
+            recs[k].local(colors[k]);
+            if 1 < self.settings.max_depth {
+                self.secondary_rays(
+                    &rays[k],
+                    at,
+                    1,
+                    &mut colors[k],
+                    query,
+                    ray_counts,
+                    &mut recs[k],
+                );
+            }
+            recs[k].finish(colors[k]);
+        }
+        colors
+    }
+
+    /// What each shadow ray towards one light lets through (`toward`: its
+    /// direction and length, `None` where none is cast): one packet in a
+    /// scene of opaque shapes, one by one otherwise (crossings of
+    /// transparent shapes are kept in order per ray).
+    #[inline(always)]
+    fn transmittance_lanes<C: Counter, const N: usize>(
+        &self,
+        origins: &[DVec3; N],
+        toward: &[Option<(DVec3, f64, f64)>; N],
+        query: &mut Query<C>,
+        stack: &mut PacketStack<N>,
+        ray_counts: &mut RayCounts,
+    ) -> [f64; N] {
+        let mut passes = [1.0; N];
+        let mut lanes = [0usize; N];
+        let mut rays = [PreparedRay::new(Ray::new(DVec3::ZERO, DVec3::X)); N];
+        let mut lengths = [0.0; N];
+        let mut n = 0;
+        for k in 0..N {
+            if let Some((l, distance, _)) = toward[k] {
+                lanes[n] = k;
+                rays[n] = PreparedRay::new(Ray::new(origins[k], l));
+                lengths[n] = distance;
+                n += 1;
+            }
+        }
+        ray_counts.shadow += n as u64;
+        if n == 0 {
+            return passes;
+        }
+        if self.settings.use_octree
+            && !self.any_transparent
+            && let Some(packet) = RayPacket::<N>::new(&rays[..n])
+        {
+            let prims = self.primitives();
+            let blocked =
+                self.octree
+                    .blocked_packet(&prims, &packet, lengths, stack, query.counter);
+            for (m, &k) in lanes[..n].iter().enumerate() {
+                passes[k] = if blocked >> m & 1 == 1 { 0.0 } else { 1.0 };
+            }
+            return passes;
+        }
+        for (m, &k) in lanes[..n].iter().enumerate() {
+            passes[k] = self.transmittance(&rays[m], lengths[m], query);
+        }
+        passes
+    }
+}

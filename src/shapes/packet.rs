@@ -1,0 +1,205 @@
+//! Packets: up to `N` coherent rays (the eye rays of neighbouring pixels,
+//! a pixel's samples, the shadow rays of neighbouring hits towards one
+//! light) tested together, one lane each. Lanes run the single-ray tests'
+//! arithmetic operation for operation, so a lane's answer is bit for bit
+//! the single ray's (Wald et al. 2001 introduced packets for coherent rays;
+//! here they must also stay exact).
+
+use super::hit::PreparedRay;
+use super::triangle::Triangle;
+use crate::simd::{F64s, map2, mask, splat};
+
+/// Up to `N` rays that share their direction's signs and the watertight
+/// test's axis permutation, and none of which is parallel to an axis plane
+/// (the octree walk and the triangle test then treat every lane alike).
+#[derive(Clone, Copy, Debug)]
+pub struct RayPacket<const N: usize> {
+    /// Each lane's ray, for the tests that run lane by lane.
+    pub rays: [PreparedRay; N],
+    /// Lanes holding a ray (the others repeat lane 0 and are never live).
+    pub live: u32,
+    pub origin: [F64s<N>; 3],
+    pub inv_dir: [F64s<N>; 3],
+    pub shear: [F64s<N>; 3],
+    /// Bit `k`: every lane's direction is negative on axis `k`.
+    pub negative: u32,
+    pub(super) permutation: u8,
+}
+
+impl<const N: usize> RayPacket<N> {
+    /// A packet of `rays` (1 to `N`), or `None` if they disagree in signs
+    /// or permutation or one is parallel to an axis plane: such rays are
+    /// traced one by one.
+    pub fn new(rays: &[PreparedRay]) -> Option<Self> {
+        let first = rays.first()?;
+        if rays.len() > N
+            || rays.iter().any(|r| {
+                r.parallel != 0
+                    || r.negative != first.negative
+                    || r.permutation != first.permutation
+            })
+        {
+            return None;
+        }
+        let lanes: [PreparedRay; N] = std::array::from_fn(|i| *rays.get(i).unwrap_or(first));
+        let component = |f: &dyn Fn(&PreparedRay) -> [f64; 3]| -> [F64s<N>; 3] {
+            std::array::from_fn(|k| std::array::from_fn(|i| f(&lanes[i])[k]))
+        };
+        Some(Self {
+            origin: component(&|r| r.ray.origin.to_array()),
+            inv_dir: component(&|r| r.inv_dir),
+            shear: component(&|r| r.shear.to_array()),
+            rays: lanes,
+            live: crate::simd::all_lanes::<N>() >> (N - rays.len()),
+            negative: first.negative,
+            permutation: first.permutation,
+        })
+    }
+}
+
+/// Per lane, the closest hit so far: its parameter (the limit beyond which
+/// nothing matters, `t_max` before any hit), the shape (`NONE` before any
+/// hit) and the barycentric coordinates of a triangle's hit.
+#[derive(Clone, Copy, Debug)]
+pub struct PacketHits<const N: usize> {
+    pub t: F64s<N>,
+    pub shape: [u32; N],
+    pub b1: F64s<N>,
+    pub b2: F64s<N>,
+    /// The exclusive limit a test must beat in each lane: `t_max` before
+    /// any hit, then just past the best `t`, since an equal `t` with a
+    /// lower shape index also wins (as in the single-ray test).
+    pub probe: F64s<N>,
+}
+
+impl<const N: usize> PacketHits<N> {
+    /// No hit yet: shape index of a lane without one.
+    pub const NONE: u32 = u32::MAX;
+
+    pub fn new(t_max: F64s<N>) -> Self {
+        Self {
+            t: t_max,
+            shape: [Self::NONE; N],
+            b1: splat(0.0),
+            b2: splat(0.0),
+            probe: t_max,
+        }
+    }
+
+    /// Keeps `index`'s hits in the `hit` lanes, each of which beat the
+    /// lane's probe, where they are closer than the best or as close with
+    /// a lower index (hits are rare: lane by lane).
+    #[inline(always)]
+    pub fn merge(&mut self, index: u32, hit: u32, t: F64s<N>, b1: F64s<N>, b2: F64s<N>) {
+        let mut lanes = hit;
+        while lanes != 0 {
+            let i = lanes.trailing_zeros() as usize;
+            lanes &= lanes - 1;
+            // The hit beat the probe, so t <= the best t: it wins unless it
+            // ties with a lower index.
+            if t[i] < self.t[i] || index < self.shape[i] {
+                self.t[i] = t[i];
+                self.b1[i] = b1[i];
+                self.b2[i] = b2[i];
+                self.shape[i] = index;
+                self.probe[i] = if t[i].is_finite() {
+                    f64::from_bits(t[i].to_bits() + 1)
+                } else {
+                    t[i]
+                };
+            }
+        }
+    }
+}
+
+/// What a triangle test found in each lane.
+pub struct LaneHits<const N: usize> {
+    /// Lanes hit within their limit.
+    pub hit: u32,
+    pub t: F64s<N>,
+    pub b1: F64s<N>,
+    pub b2: F64s<N>,
+}
+
+impl Triangle {
+    /// [`Triangle::intersect`] for every lane of `p` at once, each against
+    /// its own exclusive limit `t_max`.
+    #[inline(always)]
+    pub fn intersect_lanes<const N: usize>(
+        &self,
+        p: &RayPacket<N>,
+        t_max: &F64s<N>,
+    ) -> LaneHits<N> {
+        match p.permutation {
+            0 => self.lanes_along::<1, 2, 0, N>(p, t_max),
+            1 => self.lanes_along::<2, 1, 0, N>(p, t_max),
+            2 => self.lanes_along::<2, 0, 1, N>(p, t_max),
+            3 => self.lanes_along::<0, 2, 1, N>(p, t_max),
+            4 => self.lanes_along::<0, 1, 2, N>(p, t_max),
+            _ => self.lanes_along::<1, 0, 2, N>(p, t_max),
+        }
+    }
+
+    /// The watertight test (Woop, Benthin & Wald 2013) in lanes, with the
+    /// single-ray test's operations in the same order.
+    #[inline(always)]
+    fn lanes_along<const KX: usize, const KY: usize, const KZ: usize, const N: usize>(
+        &self,
+        p: &RayPacket<N>,
+        t_max: &F64s<N>,
+    ) -> LaneHits<N> {
+        let o = &p.origin;
+        let relative = |v: glam::DVec3| -> [F64s<N>; 3] {
+            let v = v.to_array();
+            std::array::from_fn(|k| map2(splat(v[k]), o[k], |a, b| a - b))
+        };
+        let a = relative(self.vertices[0]);
+        let b = relative(self.vertices[1]);
+        let c = relative(self.vertices[2]);
+        let (sx, sy, sz) = (p.shear[0], p.shear[1], p.shear[2]);
+        let project = |v: &[F64s<N>; 3]| -> (F64s<N>, F64s<N>) {
+            (
+                std::array::from_fn(|i| v[KX][i] - sx[i] * v[KZ][i]),
+                std::array::from_fn(|i| v[KY][i] - sy[i] * v[KZ][i]),
+            )
+        };
+        let (ax, ay) = project(&a);
+        let (bx, by) = project(&b);
+        let (cx, cy) = project(&c);
+        let u: F64s<N> = std::array::from_fn(|i| cx[i] * by[i] - cy[i] * bx[i]);
+        let v: F64s<N> = std::array::from_fn(|i| ax[i] * cy[i] - ay[i] * cx[i]);
+        let w: F64s<N> = std::array::from_fn(|i| bx[i] * ay[i] - by[i] * ax[i]);
+        let zero = splat::<N>(0.0);
+        // "Some edge function is negative" (and "positive") as one
+        // comparison each: NaN-ignoring min and max skip a NaN as the
+        // single-ray comparisons do.
+        let lowest: F64s<N> = std::array::from_fn(|i| u[i].min(v[i]).min(w[i]));
+        let highest: F64s<N> = std::array::from_fn(|i| u[i].max(v[i]).max(w[i]));
+        let negative = mask(lowest, zero, |x, z| x < z);
+        let positive = mask(highest, zero, |x, z| x > z);
+        let det: F64s<N> = std::array::from_fn(|i| u[i] + v[i] + w[i]);
+        let mut hit = !(negative & positive) & !mask(det, zero, |d, z| d == z) & p.live;
+        if hit == 0 {
+            return LaneHits {
+                hit,
+                t: zero,
+                b1: zero,
+                b2: zero,
+            };
+        }
+        let t: F64s<N> = std::array::from_fn(|i| {
+            let t_scaled = sz[i] * (u[i] * a[KZ][i] + v[i] * b[KZ][i] + w[i] * c[KZ][i]);
+            t_scaled / det[i]
+        });
+        // 0 < t < t_max as one comparison: lanes with t <= 0 (or NaN)
+        // compare +inf instead, which is never below a limit.
+        let ahead: F64s<N> = std::array::from_fn(|i| if t[i] > 0.0 { t[i] } else { f64::INFINITY });
+        hit &= mask(ahead, *t_max, |t, m| t < m);
+        LaneHits {
+            hit,
+            t,
+            b1: map2(v, det, |v, d| v / d),
+            b2: map2(w, det, |w, d| w / d),
+        }
+    }
+}

@@ -1,0 +1,218 @@
+//! SIMD levels and the lanes the packet kernels compute in.
+//!
+//! The kernels are written once over arrays of `N` lanes (`[f64; N]`) and
+//! run inside a function compiled for the machine's best instruction set,
+//! chosen at run time through `pulp` (no `unsafe`, no `-C target-cpu`): with
+//! AVX-512 eight lanes, with AVX2 four; without either, glint traces single
+//! rays. Each lane performs the same IEEE operations in the same order as
+//! the single-ray code (Rust never fuses a multiply and an add by itself),
+//! so every level gives the same bytes.
+
+use std::sync::OnceLock;
+
+/// The instruction sets glint's kernels use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SimdLevel {
+    /// No packets: every ray on its own.
+    Scalar,
+    /// Packets of four rays (x86-64-v3: AVX2, FMA, BMI, POPCNT).
+    Avx2,
+    /// Packets of eight rays (x86-64-v4: AVX-512 F, BW, CD, DQ, VL).
+    Avx512,
+}
+
+impl SimdLevel {
+    pub const ALL: [SimdLevel; 3] = [SimdLevel::Scalar, SimdLevel::Avx2, SimdLevel::Avx512];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SimdLevel::Scalar => "scalar",
+            SimdLevel::Avx2 => "avx2",
+            SimdLevel::Avx512 => "avx512",
+        }
+    }
+
+    /// Rays in a packet at this level (1: no packets).
+    pub fn lanes(self) -> usize {
+        match self {
+            SimdLevel::Scalar => 1,
+            SimdLevel::Avx2 => 4,
+            SimdLevel::Avx512 => 8,
+        }
+    }
+
+    /// Whether this machine runs the level.
+    pub fn is_available(self) -> bool {
+        match self {
+            SimdLevel::Scalar => true,
+            SimdLevel::Avx2 => pulp::x86::V3::try_new().is_some(),
+            SimdLevel::Avx512 => pulp::x86::V4::try_new().is_some(),
+        }
+    }
+
+    /// The best level this machine runs.
+    pub fn best() -> Self {
+        *SimdLevel::ALL
+            .iter()
+            .rev()
+            .find(|l| l.is_available())
+            .unwrap_or(&SimdLevel::Scalar)
+    }
+
+    /// The level glint uses: the best this machine runs, or a lower one
+    /// forced by the environment variable `GLINT_SIMD` (`scalar`, `avx2`
+    /// or `avx512`; a level the machine lacks falls back to the best it
+    /// has). Read once.
+    pub fn current() -> Self {
+        static LEVEL: OnceLock<SimdLevel> = OnceLock::new();
+        *LEVEL.get_or_init(|| {
+            let best = Self::best();
+            std::env::var("GLINT_SIMD")
+                .ok()
+                .and_then(|v| v.parse::<SimdLevel>().ok())
+                .filter(|l| l.is_available())
+                .unwrap_or(best)
+        })
+    }
+}
+
+impl std::str::FromStr for SimdLevel {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|l| l.name() == s)
+            .ok_or_else(|| format!("unknown SIMD level `{s}` (expected scalar, avx2 or avx512)"))
+    }
+}
+
+/// Work generic over the number of lanes, run by [`dispatch`].
+pub trait LaneWork {
+    type Output;
+    /// Runs with `N` lanes; called inside a function compiled for the
+    /// level's instruction set, so what it inlines uses it.
+    fn run<const N: usize>(self) -> Self::Output;
+}
+
+/// Runs `work` at `level`: with eight lanes under AVX-512, four under AVX2,
+/// and one (compiled for baseline x86-64) otherwise or where the machine
+/// lacks the level.
+#[inline(always)]
+pub fn dispatch<W: LaneWork>(level: SimdLevel, work: W) -> W::Output {
+    match level {
+        SimdLevel::Avx512 => match pulp::x86::V4::try_new() {
+            Some(simd) => pulp::Simd::vectorize(simd, Lanes(work)),
+            None => work.run::<1>(),
+        },
+        SimdLevel::Avx2 => match pulp::x86::V3::try_new() {
+            Some(simd) => pulp::Simd::vectorize(simd, Lanes(work)),
+            None => work.run::<1>(),
+        },
+        SimdLevel::Scalar => work.run::<1>(),
+    }
+}
+
+/// Adapts [`LaneWork`] to pulp: the lane count is the instruction set's
+/// number of `f64` lanes, and `run` is inlined into the function pulp
+/// compiles for that instruction set.
+struct Lanes<W>(W);
+
+impl<W: LaneWork> pulp::WithSimd for Lanes<W> {
+    type Output = W::Output;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) -> W::Output {
+        match S::F64_LANES {
+            8 => self.0.run::<8>(),
+            4 => self.0.run::<4>(),
+            _ => self.0.run::<1>(),
+        }
+    }
+}
+
+/// `N` lanes of `f64`.
+pub type F64s<const N: usize> = [f64; N];
+
+#[inline(always)]
+pub fn splat<const N: usize>(x: f64) -> F64s<N> {
+    [x; N]
+}
+
+#[inline(always)]
+pub fn map2<const N: usize>(a: F64s<N>, b: F64s<N>, f: impl Fn(f64, f64) -> f64) -> F64s<N> {
+    std::array::from_fn(|i| f(a[i], b[i]))
+}
+
+/// The larger of `a` and `b` lane by lane, for values that are never NaN
+/// (a plain comparison, which compiles to one vector instruction).
+#[inline(always)]
+pub fn max<const N: usize>(a: F64s<N>, b: F64s<N>) -> F64s<N> {
+    std::array::from_fn(|i| if a[i] > b[i] { a[i] } else { b[i] })
+}
+
+/// The smaller of `a` and `b` lane by lane, for values that are never NaN.
+#[inline(always)]
+pub fn min<const N: usize>(a: F64s<N>, b: F64s<N>) -> F64s<N> {
+    std::array::from_fn(|i| if a[i] < b[i] { a[i] } else { b[i] })
+}
+
+/// Lane `i` of the result is `a[i]` where bit `i` of `mask` is set, `b[i]`
+/// elsewhere.
+#[inline(always)]
+pub fn select<const N: usize>(mask: u32, a: F64s<N>, b: F64s<N>) -> F64s<N> {
+    std::array::from_fn(|i| if mask >> i & 1 == 1 { a[i] } else { b[i] })
+}
+
+/// Bit `i` set where `f(a[i], b[i])` holds (a vector compare and a
+/// move-mask when `f` is a comparison).
+#[inline(always)]
+pub fn mask<const N: usize>(a: F64s<N>, b: F64s<N>, f: impl Fn(f64, f64) -> bool) -> u32 {
+    let mut m = 0;
+    for i in 0..N {
+        m |= (f(a[i], b[i]) as u32) << i;
+    }
+    m
+}
+
+/// Bit `i` set where `a[i] <= min(b[i], c[i])`: a lane's interval
+/// `[a, b]` is not empty and starts before its limit `c` (for values that
+/// are never NaN). One comparison, so one vector compare and move-mask:
+/// LLVM vectorizes a single comparison reliably, a combination of several
+/// poorly.
+#[inline(always)]
+pub fn open_before<const N: usize>(a: F64s<N>, b: F64s<N>, c: F64s<N>) -> u32 {
+    mask(a, min(b, c), |x, y| x <= y)
+}
+
+/// The lanes a mask of `N` lanes can hold.
+#[inline(always)]
+pub fn all_lanes<const N: usize>() -> u32 {
+    if N >= 32 { u32::MAX } else { (1u32 << N) - 1 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lane_helpers_compute_lane_by_lane() {
+        let a = [1.0, -2.0, 3.0, f64::INFINITY];
+        let b = [0.5, -3.0, 3.0, 1.0];
+        assert_eq!(map2(a, b, |x, y| x.max(y)), [1.0, -2.0, 3.0, f64::INFINITY]);
+        assert_eq!(mask(a, b, |x, y| x <= y), 0b0100);
+        assert_eq!(select(0b1010, a, b), [0.5, -2.0, 3.0, f64::INFINITY]);
+        assert_eq!(all_lanes::<4>(), 0b1111);
+        assert_eq!(all_lanes::<1>(), 1);
+    }
+
+    #[test]
+    fn levels_parse_and_the_best_is_available() {
+        for level in SimdLevel::ALL {
+            assert_eq!(level.name().parse::<SimdLevel>(), Ok(level));
+        }
+        assert!(SimdLevel::best().is_available());
+        assert!(SimdLevel::Scalar.is_available());
+        assert!(SimdLevel::current().is_available());
+    }
+}
