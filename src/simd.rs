@@ -8,6 +8,9 @@
 //! the single-ray code (Rust never fuses a multiply and an add by itself),
 //! so every level gives the same bytes.
 
+// Lane loops index several arrays by the same lane number.
+#![allow(clippy::needless_range_loop)]
+
 use std::sync::OnceLock;
 
 /// The instruction sets glint's kernels use.
@@ -134,6 +137,42 @@ impl<W: LaneWork> pulp::WithSimd for Lanes<W> {
 /// `N` lanes of `f64`.
 pub type F64s<const N: usize> = [f64; N];
 
+/// `[f64; N]` whose lane `i` is `expr`, built by a plain loop: it stays in
+/// the function being compiled for the SIMD level, where the closures of
+/// `std::array::from_fn` may be left out of line (and then compiled for
+/// baseline x86-64, lane by lane).
+macro_rules! lanes {
+    ($n:expr, |$i:ident| $e:expr) => {{
+        let mut out = [0.0f64; $n];
+        for $i in 0..$n {
+            out[$i] = $e;
+        }
+        out
+    }};
+}
+pub(crate) use lanes;
+
+/// `[x, y, z]` whose entry `k` is `expr`, written out (no closure).
+macro_rules! per_axis {
+    (|$k:ident| $e:expr) => {
+        [
+            {
+                let $k = 0;
+                $e
+            },
+            {
+                let $k = 1;
+                $e
+            },
+            {
+                let $k = 2;
+                $e
+            },
+        ]
+    };
+}
+pub(crate) use per_axis;
+
 #[inline(always)]
 pub fn splat<const N: usize>(x: f64) -> F64s<N> {
     [x; N]
@@ -141,27 +180,27 @@ pub fn splat<const N: usize>(x: f64) -> F64s<N> {
 
 #[inline(always)]
 pub fn map2<const N: usize>(a: F64s<N>, b: F64s<N>, f: impl Fn(f64, f64) -> f64) -> F64s<N> {
-    std::array::from_fn(|i| f(a[i], b[i]))
+    lanes!(N, |i| f(a[i], b[i]))
 }
 
 /// The larger of `a` and `b` lane by lane, for values that are never NaN
 /// (a plain comparison, which compiles to one vector instruction).
 #[inline(always)]
 pub fn max<const N: usize>(a: F64s<N>, b: F64s<N>) -> F64s<N> {
-    std::array::from_fn(|i| if a[i] > b[i] { a[i] } else { b[i] })
+    lanes!(N, |i| if a[i] > b[i] { a[i] } else { b[i] })
 }
 
 /// The smaller of `a` and `b` lane by lane, for values that are never NaN.
 #[inline(always)]
 pub fn min<const N: usize>(a: F64s<N>, b: F64s<N>) -> F64s<N> {
-    std::array::from_fn(|i| if a[i] < b[i] { a[i] } else { b[i] })
+    lanes!(N, |i| if a[i] < b[i] { a[i] } else { b[i] })
 }
 
 /// Lane `i` of the result is `a[i]` where bit `i` of `mask` is set, `b[i]`
 /// elsewhere.
 #[inline(always)]
 pub fn select<const N: usize>(mask: u32, a: F64s<N>, b: F64s<N>) -> F64s<N> {
-    std::array::from_fn(|i| if mask >> i & 1 == 1 { a[i] } else { b[i] })
+    lanes!(N, |i| if mask >> i & 1 == 1 { a[i] } else { b[i] })
 }
 
 /// Bit `i` set where `f(a[i], b[i])` holds (a vector compare and a

@@ -2,6 +2,9 @@
 //! octree's leaves run, and brute force is, over every shape. Apart from
 //! `mod.rs` so that the octree depends on it and not on its parent.
 
+// Lane loops index several arrays by the same lane number.
+#![allow(clippy::needless_range_loop)]
+
 use crate::shapes::{PacketHits, PreparedRay, RayPacket, Shape, ShapeHit};
 use crate::simd::F64s;
 use crate::stats::Counter;
@@ -41,7 +44,7 @@ impl<'a> Primitives<'a> {
     }
 
     #[inline(always)]
-    fn is_transparent(&self, index: u32) -> bool {
+    pub(crate) fn is_transparent(&self, index: u32) -> bool {
         self.transparent.get(index as usize) == Some(&true)
     }
 
@@ -67,6 +70,10 @@ impl<'a> Primitives<'a> {
         match &self.shapes[index as usize] {
             Shape::Triangle(t) if self.one_sided.get(index as usize) != Some(&true) => {
                 let h = t.intersect_lanes(p, &probe);
+                best.merge(index, h.hit & lanes, h.t, h.b1, h.b2);
+            }
+            Shape::Sphere(s) if self.one_sided.get(index as usize) != Some(&true) => {
+                let h = s.intersect_lanes(p, &probe);
                 best.merge(index, h.hit & lanes, h.t, h.b1, h.b2);
             }
             _ => {
@@ -100,6 +107,9 @@ impl<'a> Primitives<'a> {
         match &self.shapes[index as usize] {
             Shape::Triangle(t) if self.one_sided.get(index as usize) != Some(&true) => {
                 t.intersect_lanes(p, t_max).hit & lanes
+            }
+            Shape::Sphere(s) if self.one_sided.get(index as usize) != Some(&true) => {
+                s.intersect_lanes(p, t_max).hit & lanes
             }
             _ => {
                 let mut blocked = 0;

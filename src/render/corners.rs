@@ -15,7 +15,7 @@ use crate::stats::RenderCounts;
 
 use super::passes::{FinishedTile, PassInfo, PassWatch};
 use super::renderer::Renderer;
-use super::sampling::{PixelSum, TileJob};
+use super::tile_job::{PixelSum, TileJob};
 use super::tiles::{Tile, corner_bands};
 
 /// Corner rows traced so far, by band, and which bands of pixels were shown.

@@ -14,6 +14,7 @@ pub mod memory;
 mod packets;
 mod passes;
 mod sampling;
+mod tile_job;
 pub mod tiles;
 
 mod renderer;

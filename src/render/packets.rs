@@ -8,7 +8,10 @@
 //! permutation, none parallel to an axis plane); any other group falls back
 //! to single rays, lane by lane.
 
-use crate::accel::{ClosestHit, PacketStack};
+// Lane loops index several arrays by the same lane number.
+#![allow(clippy::needless_range_loop)]
+
+use crate::accel::{ClosestHit, PacketStack, ShadowCrossings};
 use crate::math::{Color, DVec3, Ray};
 use crate::ray_tree::{NoRecord, RayRecorder};
 use crate::shapes::{PacketHits, PreparedRay, RayPacket, ShapeHit};
@@ -18,8 +21,15 @@ use crate::stats::{Counter, NoCounts, RayCounts, RenderCounts, WorkCounts};
 use super::adaptive::Signature;
 use super::integrator::ShadingPoint;
 use super::renderer::{Query, Renderer, Scratch};
-use super::sampling::{PixelSum, TileJob, TileOutput};
+use super::tile_job::{PixelSum, TileJob, TileOutput};
 use super::tiles::Tile;
+
+/// Scratch space for a tile's packets: the walk's stack and each lane's
+/// shadow crossings.
+pub(super) struct PacketScratch<const N: usize> {
+    walk: PacketStack<N>,
+    crossings: [ShadowCrossings; N],
+}
 
 /// A tile's job, run by [`crate::simd::dispatch`] with the level's lanes.
 pub(super) struct PacketTile<'r, 'a> {
@@ -40,7 +50,10 @@ impl LaneWork for PacketTile<'_, '_> {
             counts: RenderCounts::default(),
         };
         let mut scratch = Scratch::default();
-        let mut stack = PacketStack::<N>::default();
+        let mut stack = PacketScratch::<N> {
+            walk: PacketStack::default(),
+            crossings: std::array::from_fn(|_| ShadowCrossings::default()),
+        };
         let r = self.renderer;
         if self.count_work {
             let mut work = WorkCounts::default();
@@ -76,7 +89,7 @@ impl Renderer<'_> {
         job: TileJob,
         tile: Tile,
         query: &mut Query<C>,
-        stack: &mut PacketStack<N>,
+        stack: &mut PacketScratch<N>,
         out: &mut TileOutput,
     ) {
         let width = self.settings.width;
@@ -155,7 +168,7 @@ impl Renderer<'_> {
         i: u32,
         j: u32,
         query: &mut Query<C>,
-        stack: &mut PacketStack<N>,
+        stack: &mut PacketScratch<N>,
         counts: &mut RenderCounts,
     ) -> DVec3 {
         let mut pixel = PixelSum::default();
@@ -180,7 +193,7 @@ impl Renderer<'_> {
         &self,
         rays: &[Ray],
         query: &mut Query<C>,
-        stack: &mut PacketStack<N>,
+        stack: &mut PacketScratch<N>,
         counts: &mut RenderCounts,
         recs: &mut [R; N],
     ) -> [DVec3; N] {
@@ -216,7 +229,7 @@ impl Renderer<'_> {
         &self,
         rays: &[PreparedRay],
         query: &mut Query<C>,
-        stack: &mut PacketStack<N>,
+        stack: &mut PacketScratch<N>,
     ) -> [Option<ClosestHit>; N] {
         if self.settings.use_octree
             && let Some(packet) = RayPacket::<N>::new(rays)
@@ -226,7 +239,7 @@ impl Renderer<'_> {
                 &prims,
                 &packet,
                 splat(f64::INFINITY),
-                stack,
+                &mut stack.walk,
                 query.counter,
             );
             return std::array::from_fn(|k| {
@@ -258,7 +271,7 @@ impl Renderer<'_> {
         rays: &[Ray],
         hits: &[Option<ClosestHit>; N],
         query: &mut Query<C>,
-        stack: &mut PacketStack<N>,
+        stack: &mut PacketScratch<N>,
         ray_counts: &mut RayCounts,
         recs: &mut [R; N],
     ) -> [Color; N] {
@@ -345,7 +358,7 @@ impl Renderer<'_> {
         origins: &[DVec3; N],
         toward: &[Option<(DVec3, f64, f64)>; N],
         query: &mut Query<C>,
-        stack: &mut PacketStack<N>,
+        stack: &mut PacketScratch<N>,
         ray_counts: &mut RayCounts,
     ) -> [f64; N] {
         let mut passes = [1.0; N];
@@ -366,15 +379,24 @@ impl Renderer<'_> {
             return passes;
         }
         if self.settings.use_octree
-            && !self.any_transparent
             && let Some(packet) = RayPacket::<N>::new(&rays[..n])
         {
             let prims = self.primitives();
-            let blocked =
-                self.octree
-                    .blocked_packet(&prims, &packet, lengths, stack, query.counter);
+            let found = &mut stack.crossings;
+            let blocked = self.octree.occlusion_packet(
+                &prims,
+                &packet,
+                lengths,
+                found,
+                &mut stack.walk,
+                query.counter,
+            );
             for (m, &k) in lanes[..n].iter().enumerate() {
-                passes[k] = if blocked >> m & 1 == 1 { 0.0 } else { 1.0 };
+                passes[k] = if blocked >> m & 1 == 1 {
+                    0.0
+                } else {
+                    self.pass_through(&found[m])
+                };
             }
             return passes;
         }

@@ -21,7 +21,7 @@ use crate::stats::RenderCounts;
 
 use super::adaptive::refine_mask;
 use super::renderer::Renderer;
-use super::sampling::{TileJob, TileOutput};
+use super::tile_job::{TileJob, TileOutput};
 use super::tiles::{Tile, corner_bands, place_tile, tiles};
 
 /// One sweep over the image.

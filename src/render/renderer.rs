@@ -79,8 +79,6 @@ pub struct Renderer<'a> {
     pub(super) floor_scale: f64,
     /// Packets of this many lanes where rays are coherent (1: single rays).
     pub(super) simd: SimdLevel,
-    /// Whether any shape lets light through (shadow packets need none).
-    pub(super) any_transparent: bool,
 }
 
 impl<'a> Renderer<'a> {
@@ -125,9 +123,7 @@ impl<'a> Renderer<'a> {
                 ..m.clone()
             })
             .collect();
-        let any_transparent = is_transparent.contains(&true);
         Ok(Self {
-            any_transparent,
             scene,
             octree,
             settings,
@@ -219,7 +215,7 @@ impl<'a> Renderer<'a> {
     }
 
     /// The light a shadow ray's crossings let through.
-    fn pass_through(&self, found: &ShadowCrossings) -> f64 {
+    pub(super) fn pass_through(&self, found: &ShadowCrossings) -> f64 {
         if found.is_blocked() {
             return 0.0;
         }

@@ -1,6 +1,7 @@
 //! From eye rays to pixels: a sample is the view's value for one eye ray
 //! (a shaded colour, a normal, a distance or the work it took), a pixel
-//! the mean of its samples; a tile job fills one tile of a pass.
+//! the mean of its samples; a tile job fills one tile of a pass, in
+//! packets of rays where the scene allows it and one ray at a time elsewhere.
 
 use crate::math::{DVec3, Ray};
 use crate::ray_tree::{NoRecord, RayRecorder};
@@ -10,35 +11,8 @@ use crate::stats::{Counter, NoCounts, RayCounts, RenderCounts, WorkCounts};
 
 use super::adaptive::Signature;
 use super::renderer::{Query, Renderer, Scratch};
+use super::tile_job::{PixelSum, TileJob, TileOutput};
 use super::tiles::Tile;
-
-/// What one tile of a pass computes.
-#[derive(Clone, Copy)]
-pub(super) enum TileJob<'a> {
-    /// One ray through each pixel's centre; with `signatures`, what each
-    /// ray met is kept for adaptive anti-aliasing.
-    Centre { signatures: bool },
-    /// The full grid in every pixel.
-    Grid,
-    /// The full grid where `mask` (frame-sized, row-major) marks the pixel,
-    /// the one-sample value (`first`, frame-sized) elsewhere.
-    Refine {
-        first: &'a [DVec3],
-        mask: &'a [bool],
-    },
-    /// The SPD protocol's corner rays: the tile is in corner coordinates
-    /// (an image of `w x h` pixels has `(w + 1) x (h + 1)` corners), and
-    /// each value is one corner's sample.
-    Corners,
-}
-
-/// A finished tile: its pixels row-major, the signatures of a centre pass
-/// that keeps them, and what it counted.
-pub(super) struct TileOutput {
-    pub values: Vec<DVec3>,
-    pub signatures: Vec<u64>,
-    pub counts: RenderCounts,
-}
 
 impl Renderer<'_> {
     /// Runs `job` over `tile`, counting Havran's work measures when
@@ -217,36 +191,6 @@ impl Renderer<'_> {
                 (facing + DVec3::ONE) * 0.5
             }
             _ => DVec3::new(hit.hit.t, 1.0, 0.0),
-        }
-    }
-}
-
-/// A pixel's samples as they arrive: their sum and their number.
-#[derive(Clone, Copy, Default)]
-pub(super) struct PixelSum {
-    sum: DVec3,
-    n: u32,
-}
-
-impl PixelSum {
-    #[inline]
-    pub(super) fn add(&mut self, sample: DVec3) {
-        self.sum += sample;
-        self.n += 1;
-    }
-
-    /// The pixel: the samples' mean; for the depth view the mean distance
-    /// of those that hit (`x` sums distances, `y` hits) and the share that
-    /// hit; for the cost views their sum (`cost_sum`) or mean.
-    pub(super) fn value(&self, view: ViewMode, cost_sum: bool) -> DVec3 {
-        let n = self.n.max(1) as f64;
-        match view {
-            ViewMode::Depth if self.sum.y > 0.0 => {
-                DVec3::new(self.sum.x / self.sum.y, self.sum.y / n, 0.0)
-            }
-            ViewMode::Depth => DVec3::ZERO,
-            ViewMode::Cost | ViewMode::CostSteps if cost_sum => self.sum,
-            _ => self.sum / n,
         }
     }
 }

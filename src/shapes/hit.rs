@@ -31,28 +31,31 @@ impl PreparedRay {
     pub fn new(ray: Ray) -> Self {
         let d = ray.dir;
         let a = d.abs();
-        let kz = if a.x >= a.y && a.x >= a.z {
-            0
+        // The dominant axis, and whether the direction is negative along
+        // it: one of six permutations, each with constant axes below (a
+        // vector indexed by a variable costs a match per access).
+        let permutation = if a.x >= a.y && a.x >= a.z {
+            (d.x < 0.0) as u8
         } else if a.y >= a.z {
-            1
+            2 + (d.y < 0.0) as u8
         } else {
-            2
+            4 + (d.z < 0.0) as u8
         };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        // Keep the winding of the projected triangle independent of the sign.
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
-        let shear = DVec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
-        let permutation = (2 * kz + (d[kz] < 0.0) as usize) as u8;
-        debug_assert_eq!(Self::axes_of(permutation), (kx, ky, kz));
+        let shear = match permutation {
+            0 => DVec3::new(d.y / d.x, d.z / d.x, 1.0 / d.x),
+            1 => DVec3::new(d.z / d.x, d.y / d.x, 1.0 / d.x),
+            2 => DVec3::new(d.z / d.y, d.x / d.y, 1.0 / d.y),
+            3 => DVec3::new(d.x / d.y, d.z / d.y, 1.0 / d.y),
+            4 => DVec3::new(d.x / d.z, d.y / d.z, 1.0 / d.z),
+            _ => DVec3::new(d.y / d.z, d.x / d.z, 1.0 / d.z),
+        };
+        let d = d.to_array();
         let mut inv_dir = [0.0; 3];
         let (mut negative, mut parallel) = (0, 0);
-        for (k, inv_k) in inv_dir.iter_mut().enumerate() {
+        for k in 0..3 {
             let inv = 1.0 / d[k];
             if inv.is_finite() {
-                *inv_k = inv;
+                inv_dir[k] = inv;
                 negative |= ((d[k] < 0.0) as u32) << k;
             } else {
                 parallel |= 1 << k;
@@ -71,6 +74,7 @@ impl PreparedRay {
     /// The permutation's axes `(kx, ky, kz)`: `kz` the dominant one, the
     /// others in cyclic order, swapped when the dominant component is
     /// negative.
+    #[cfg(test)]
     pub(super) fn axes_of(permutation: u8) -> (usize, usize, usize) {
         match permutation {
             0 => (1, 2, 0),
@@ -142,4 +146,41 @@ pub struct Surface {
 pub(super) fn unit_or_none(v: DVec3) -> Option<DVec3> {
     let len = v.length();
     (len > 0.0 && len.is_finite()).then(|| v / len)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_permutation_is_woops_axes_and_shear() {
+        // Woop et al.: kz the largest |d|, kx and ky the next ones in
+        // cyclic order, swapped when d[kz] < 0; shear (dx/dz, dy/dz, 1/dz).
+        for d in [
+            DVec3::new(3.0, 1.0, -2.0),
+            DVec3::new(-3.0, 1.0, 2.0),
+            DVec3::new(0.5, 2.0, 1.0),
+            DVec3::new(0.5, -2.0, 1.0),
+            DVec3::new(0.25, 1.0, 3.0),
+            DVec3::new(0.25, 1.0, -3.0),
+            DVec3::new(1.0, 1.0, 1.0),
+        ] {
+            let r = PreparedRay::new(Ray::new(DVec3::ZERO, d));
+            let a = d.abs();
+            let kz = if a.x >= a.y && a.x >= a.z {
+                0
+            } else if a.y >= a.z {
+                1
+            } else {
+                2
+            };
+            let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
+            if d[kz] < 0.0 {
+                std::mem::swap(&mut kx, &mut ky);
+            }
+            assert_eq!(PreparedRay::axes_of(r.permutation), (kx, ky, kz), "{d}");
+            let shear = DVec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
+            assert_eq!(r.shear, shear, "{d}");
+        }
+    }
 }

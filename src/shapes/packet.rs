@@ -5,9 +5,13 @@
 //! the single ray's (Wald et al. 2001 introduced packets for coherent rays;
 //! here they must also stay exact).
 
+// Lane loops index several arrays by the same lane number.
+#![allow(clippy::needless_range_loop)]
+
 use super::hit::PreparedRay;
+use super::sphere::Sphere;
 use super::triangle::Triangle;
-use crate::simd::{F64s, map2, mask, splat};
+use crate::simd::{F64s, lanes, map2, mask, per_axis, splat};
 
 /// Up to `N` rays that share their direction's signs and the watertight
 /// test's axis permutation, and none of which is parallel to an axis plane
@@ -19,6 +23,7 @@ pub struct RayPacket<const N: usize> {
     /// Lanes holding a ray (the others repeat lane 0 and are never live).
     pub live: u32,
     pub origin: [F64s<N>; 3],
+    pub dir: [F64s<N>; 3],
     pub inv_dir: [F64s<N>; 3],
     pub shear: [F64s<N>; 3],
     /// Bit `k`: every lane's direction is negative on axis `k`.
@@ -30,6 +35,7 @@ impl<const N: usize> RayPacket<N> {
     /// A packet of `rays` (1 to `N`), or `None` if they disagree in signs
     /// or permutation or one is parallel to an axis plane: such rays are
     /// traced one by one.
+    #[inline(always)]
     pub fn new(rays: &[PreparedRay]) -> Option<Self> {
         let first = rays.first()?;
         if rays.len() > N
@@ -47,6 +53,7 @@ impl<const N: usize> RayPacket<N> {
         };
         Some(Self {
             origin: component(&|r| r.ray.origin.to_array()),
+            dir: component(&|r| r.ray.dir.to_array()),
             inv_dir: component(&|r| r.inv_dir),
             shear: component(&|r| r.shear.to_array()),
             rays: lanes,
@@ -151,7 +158,7 @@ impl Triangle {
         let o = &p.origin;
         let relative = |v: glam::DVec3| -> [F64s<N>; 3] {
             let v = v.to_array();
-            std::array::from_fn(|k| map2(splat(v[k]), o[k], |a, b| a - b))
+            per_axis!(|k| map2(splat(v[k]), o[k], |a, b| a - b))
         };
         let a = relative(self.vertices[0]);
         let b = relative(self.vertices[1]);
@@ -159,25 +166,25 @@ impl Triangle {
         let (sx, sy, sz) = (p.shear[0], p.shear[1], p.shear[2]);
         let project = |v: &[F64s<N>; 3]| -> (F64s<N>, F64s<N>) {
             (
-                std::array::from_fn(|i| v[KX][i] - sx[i] * v[KZ][i]),
-                std::array::from_fn(|i| v[KY][i] - sy[i] * v[KZ][i]),
+                lanes!(N, |i| v[KX][i] - sx[i] * v[KZ][i]),
+                lanes!(N, |i| v[KY][i] - sy[i] * v[KZ][i]),
             )
         };
         let (ax, ay) = project(&a);
         let (bx, by) = project(&b);
         let (cx, cy) = project(&c);
-        let u: F64s<N> = std::array::from_fn(|i| cx[i] * by[i] - cy[i] * bx[i]);
-        let v: F64s<N> = std::array::from_fn(|i| ax[i] * cy[i] - ay[i] * cx[i]);
-        let w: F64s<N> = std::array::from_fn(|i| bx[i] * ay[i] - by[i] * ax[i]);
+        let u: F64s<N> = lanes!(N, |i| cx[i] * by[i] - cy[i] * bx[i]);
+        let v: F64s<N> = lanes!(N, |i| ax[i] * cy[i] - ay[i] * cx[i]);
+        let w: F64s<N> = lanes!(N, |i| bx[i] * ay[i] - by[i] * ax[i]);
         let zero = splat::<N>(0.0);
         // "Some edge function is negative" (and "positive") as one
         // comparison each: NaN-ignoring min and max skip a NaN as the
         // single-ray comparisons do.
-        let lowest: F64s<N> = std::array::from_fn(|i| u[i].min(v[i]).min(w[i]));
-        let highest: F64s<N> = std::array::from_fn(|i| u[i].max(v[i]).max(w[i]));
+        let lowest: F64s<N> = lanes!(N, |i| u[i].min(v[i]).min(w[i]));
+        let highest: F64s<N> = lanes!(N, |i| u[i].max(v[i]).max(w[i]));
         let negative = mask(lowest, zero, |x, z| x < z);
         let positive = mask(highest, zero, |x, z| x > z);
-        let det: F64s<N> = std::array::from_fn(|i| u[i] + v[i] + w[i]);
+        let det: F64s<N> = lanes!(N, |i| u[i] + v[i] + w[i]);
         let mut hit = !(negative & positive) & !mask(det, zero, |d, z| d == z) & p.live;
         if hit == 0 {
             return LaneHits {
@@ -187,19 +194,91 @@ impl Triangle {
                 b2: zero,
             };
         }
-        let t: F64s<N> = std::array::from_fn(|i| {
+        let t: F64s<N> = lanes!(N, |i| {
             let t_scaled = sz[i] * (u[i] * a[KZ][i] + v[i] * b[KZ][i] + w[i] * c[KZ][i]);
             t_scaled / det[i]
         });
         // 0 < t < t_max as one comparison: lanes with t <= 0 (or NaN)
         // compare +inf instead, which is never below a limit.
-        let ahead: F64s<N> = std::array::from_fn(|i| if t[i] > 0.0 { t[i] } else { f64::INFINITY });
+        let ahead: F64s<N> = lanes!(N, |i| if t[i] > 0.0 { t[i] } else { f64::INFINITY });
         hit &= mask(ahead, *t_max, |t, m| t < m);
         LaneHits {
             hit,
             t,
             b1: map2(v, det, |v, d| v / d),
             b2: map2(w, det, |w, d| w / d),
+        }
+    }
+}
+
+impl Sphere {
+    /// [`Sphere::intersect`] for every lane of `p` at once, each against
+    /// its own exclusive limit `t_max`, with the single-ray test's
+    /// operations in the same order.
+    #[inline(always)]
+    pub fn intersect_lanes<const N: usize>(
+        &self,
+        p: &RayPacket<N>,
+        t_max: &F64s<N>,
+    ) -> LaneHits<N> {
+        let c = self.center.to_array();
+        let (o, d) = (&p.origin, &p.dir);
+        let f: [F64s<N>; 3] = per_axis!(|k| map2(o[k], splat(c[k]), |a, b| a - b));
+        let dot = |a: &[F64s<N>; 3], b: &[F64s<N>; 3]| -> F64s<N> {
+            lanes!(N, |i| a[0][i] * b[0][i]
+                + a[1][i] * b[1][i]
+                + a[2][i] * b[2][i])
+        };
+        let b = dot(&f, d);
+        let perp: [F64s<N>; 3] = per_axis!(|k| lanes!(N, |i| f[k][i] - b[i] * d[k][i]));
+        let r2 = self.radius * self.radius;
+        let perp2 = dot(&perp, &perp);
+        let disc: F64s<N> = lanes!(N, |i| r2 - perp2[i]);
+        let zero = splat::<N>(0.0);
+        let mut hit = mask(disc, zero, |x, z| x >= z) & p.live;
+        if hit == 0 {
+            return LaneHits {
+                hit,
+                t: zero,
+                b1: zero,
+                b2: zero,
+            };
+        }
+        let f2 = dot(&f, &f);
+        let mut near = [0.0; N];
+        let mut far = [0.0; N];
+        for i in 0..N {
+            let cc = f2[i] - r2;
+            let q = -(b[i] + disc[i].sqrt().copysign(b[i]));
+            let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (cc / q, q) };
+            (near[i], far[i]) = if t0 <= t1 { (t0, t1) } else { (t1, t0) };
+        }
+        // The near root if it lies in (0, t_max), else the far one.
+        let near_ok = mask(
+            lanes!(N, |i| if near[i] > 0.0 {
+                near[i]
+            } else {
+                f64::INFINITY
+            }),
+            *t_max,
+            |t, m| t < m,
+        );
+        let t: F64s<N> = lanes!(N, |i| if near_ok >> i & 1 == 1 {
+            near[i]
+        } else {
+            far[i]
+        });
+        let far_ok = mask(
+            lanes!(N, |i| if far[i] > 0.0 { far[i] } else { f64::INFINITY }),
+            *t_max,
+            |t, m| t < m,
+        );
+        hit &= near_ok | far_ok;
+        LaneHits {
+            hit,
+            t,
+            b1: zero,
+            b2: zero,
         }
     }
 }

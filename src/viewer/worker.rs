@@ -466,6 +466,27 @@ impl PassWatch for Display<'_> {
         if self.stale() {
             return;
         }
+        // The record goes in before the buffer says finished, so whoever
+        // waits for the finished buffer also finds its pass in the history.
+        let summary = pass.summary;
+        if let Ok(mut history) = self.shared.history.lock() {
+            history.push(PassRecord {
+                generation: self.generation,
+                kind: PassKind::of(pass.info.kind, self.job.preview),
+                seconds: summary.seconds,
+                rays: summary.counts.rays,
+                octree: self.settings.use_octree,
+                anti_aliasing: self.job.settings.samples > 1,
+                width: pass.frame.width,
+                height: pass.frame.height,
+                finished_at: self.shared.started.elapsed().as_secs_f64(),
+                one_sample_error: summary.one_sample_error,
+                refined_pixels: summary.refined_pixels,
+                view: self.job.settings.view,
+                max_depth: self.settings.max_depth,
+                protocol: self.settings.protocol,
+            });
+        }
         let frame = pass.frame;
         let rgba = rgb_to_rgba(&frame.to_rgb8());
         {
@@ -480,25 +501,6 @@ impl PassWatch for Display<'_> {
             b.finished = pass.info.is_last();
             b.last_frame = Some(frame.clone());
             b.version += 1;
-        }
-        let summary = pass.summary;
-        if let Ok(mut history) = self.shared.history.lock() {
-            history.push(PassRecord {
-                generation: self.generation,
-                kind: PassKind::of(pass.info.kind, self.job.preview),
-                seconds: summary.seconds,
-                rays: summary.counts.rays,
-                octree: self.settings.use_octree,
-                anti_aliasing: self.job.settings.samples > 1,
-                width: frame.width,
-                height: frame.height,
-                finished_at: self.shared.started.elapsed().as_secs_f64(),
-                one_sample_error: summary.one_sample_error,
-                refined_pixels: summary.refined_pixels,
-                view: self.job.settings.view,
-                max_depth: self.settings.max_depth,
-                protocol: self.settings.protocol,
-            });
         }
         (self.shared.repaint)();
     }

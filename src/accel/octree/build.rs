@@ -4,10 +4,10 @@
 
 use rayon::prelude::*;
 
+use super::node::LEVEL_MASK;
 use super::node::{Cell, INTERIOR, Node};
 use super::params::{OctreeError, OctreeParams, OctreeStats};
 use super::tree::Octree;
-use super::walk::LEVEL_MASK;
 use crate::math::{Aabb, DVec3};
 use crate::shapes::Shape;
 

@@ -2,7 +2,12 @@
 //! children, and the cubic cells the build and the traversal derive with
 //! the same arithmetic.
 
+use crate::limits::MAX_OCTREE_DEPTH;
 use crate::math::{Aabb, DVec3};
+
+/// Levels the side table holds, less one: a power of two less one, so
+/// a level is masked into it instead of bounds-checked.
+pub(super) const LEVEL_MASK: usize = (MAX_OCTREE_DEPTH as usize + 2).next_power_of_two() - 1;
 
 /// Leaf: `refs[first .. first + count]`. Interior: a mask of the octants
 /// holding anything (octant bit 0 = upper x, bit 1 = upper y, bit 2 =

@@ -10,19 +10,23 @@
 //! the single ray's (the closest hit is the lexicographic minimum of
 //! `(t, shape index)` whatever the order of the tests).
 
-use super::super::primitives::Primitives;
+// Lane loops index several arrays by the same lane number.
+#![allow(clippy::needless_range_loop)]
+
+use super::node::LEVEL_MASK;
+use super::node::Node;
 use super::tree::Octree;
-use super::walk::LEVEL_MASK;
+use crate::accel::primitives::{Primitives, ShadowCrossings, test_occlusion};
 use crate::limits::MAX_OCTREE_DEPTH;
 use crate::shapes::{PacketHits, RayPacket};
-use crate::simd::{F64s, mask, max, min, open_before};
+use crate::simd::{F64s, lanes, mask, max, min, open_before, per_axis};
 use crate::stats::Counter;
 
 /// A cell waiting on a packet's stack: its corner, node and level, and
 /// each lane's parameters at its entry and exit (empty where the lane's
 /// ray misses it).
 #[derive(Clone, Copy, Debug)]
-pub struct PacketEntry<const N: usize> {
+struct PacketEntry<const N: usize> {
     min: [f64; 3],
     t0: F64s<N>,
     t1: F64s<N>,
@@ -30,33 +34,27 @@ pub struct PacketEntry<const N: usize> {
     level: u32,
 }
 
-impl<const N: usize> Default for PacketEntry<N> {
-    fn default() -> Self {
-        Self {
-            min: [0.0; 3],
-            t0: [0.0; N],
-            t1: [0.0; N],
-            node: 0,
-            level: 0,
-        }
-    }
-}
-
 /// Room on a packet's stack: each level may leave seven siblings waiting,
 /// plus the cell being entered.
 pub const PACKET_STACK_CAPACITY: usize = 7 * MAX_OCTREE_DEPTH as usize + 8;
 
 /// The cells a packet has still to visit: scratch space the caller owns
-/// (allocated once, never cleared: entries are written before they are
-/// read).
+/// (one per tile).
 pub struct PacketStack<const N: usize> {
     entries: Vec<PacketEntry<N>>,
 }
 
 impl<const N: usize> Default for PacketStack<N> {
     fn default() -> Self {
+        let empty = PacketEntry {
+            min: [0.0; 3],
+            t0: [0.0; N],
+            t1: [0.0; N],
+            node: 0,
+            level: 0,
+        };
         Self {
-            entries: Vec::with_capacity(PACKET_STACK_CAPACITY),
+            entries: vec![empty; PACKET_STACK_CAPACITY],
         }
     }
 }
@@ -93,20 +91,41 @@ impl<C: Counter, const N: usize> PacketVisitor<N> for Closest<'_, C, N> {
     }
 }
 
-struct Blocked<'a, C, const N: usize> {
+struct Shadowed<'a, C, const N: usize> {
     prims: &'a Primitives<'a>,
     packet: &'a RayPacket<N>,
     t_max: F64s<N>,
     /// Lanes an opaque shape blocks; their limit drops below every cell.
     blocked: u32,
+    /// Each lane's crossings of transparent shapes.
+    found: &'a mut [ShadowCrossings; N],
     counter: &'a mut C,
 }
 
-impl<C: Counter, const N: usize> PacketVisitor<N> for Blocked<'_, C, N> {
+impl<C: Counter, const N: usize> PacketVisitor<N> for Shadowed<'_, C, N> {
     #[inline(always)]
     fn test(&mut self, index: u32, lanes: u32) {
         let lanes = lanes & !self.blocked;
-        if lanes != 0 {
+        if lanes == 0 {
+            return;
+        }
+        if self.prims.is_transparent(index) {
+            // Light passes: each lane keeps its crossings, as a single
+            // shadow ray does.
+            for i in 0..N {
+                if lanes >> i & 1 == 1 {
+                    let ray = &self.packet.rays[i];
+                    test_occlusion(
+                        self.prims,
+                        index,
+                        ray,
+                        self.t_max[i],
+                        &mut self.found[i],
+                        self.counter,
+                    );
+                }
+            }
+        } else {
             self.blocked |=
                 self.prims
                     .blocked_lanes(index, self.packet, &self.t_max, lanes, self.counter);
@@ -114,12 +133,10 @@ impl<C: Counter, const N: usize> PacketVisitor<N> for Blocked<'_, C, N> {
     }
     #[inline(always)]
     fn limit(&self) -> F64s<N> {
-        std::array::from_fn(|i| {
-            if self.blocked >> i & 1 == 1 {
-                f64::NEG_INFINITY
-            } else {
-                self.t_max[i]
-            }
+        lanes!(N, |i| if self.blocked >> i & 1 == 1 {
+            f64::NEG_INFINITY
+        } else {
+            self.t_max[i]
         })
     }
     #[inline(always)]
@@ -174,22 +191,29 @@ impl Octree {
         visitor.best
     }
 
-    /// The lanes whose shadow ray an opaque shape blocks within `t_max`
-    /// (for scenes without transparent shapes).
+    /// What each lane's shadow ray meets over `(0, t_max)`: the lanes an
+    /// opaque shape blocks (returned), and each other lane's crossings of
+    /// transparent shapes into `found` (cleared first), as
+    /// [`Octree::occlusion`] finds them for the lane's ray alone.
     #[inline(always)]
-    pub fn blocked_packet<C: Counter, const N: usize>(
+    pub fn occlusion_packet<C: Counter, const N: usize>(
         &self,
         prims: &Primitives,
         packet: &RayPacket<N>,
         t_max: F64s<N>,
+        found: &mut [ShadowCrossings; N],
         stack: &mut PacketStack<N>,
         counter: &mut C,
     ) -> u32 {
-        let mut visitor = Blocked {
+        for f in found.iter_mut() {
+            f.clear();
+        }
+        let mut visitor = Shadowed {
             prims,
             packet,
             t_max,
             blocked: 0,
+            found,
             counter,
         };
         for &i in &self.unbounded {
@@ -216,8 +240,8 @@ impl Octree {
         let mut t0 = [0.0f64; N];
         let mut t1 = limit;
         for k in 0..3 {
-            let mut near: F64s<N> = std::array::from_fn(|i| (lo[k] - o[k][i]) * inv[k][i]);
-            let mut far: F64s<N> = std::array::from_fn(|i| (hi[k] - o[k][i]) * inv[k][i]);
+            let mut near: F64s<N> = lanes!(N, |i| (lo[k] - o[k][i]) * inv[k][i]);
+            let mut far: F64s<N> = lanes!(N, |i| (hi[k] - o[k][i]) * inv[k][i]);
             if p.negative >> k & 1 == 1 {
                 std::mem::swap(&mut near, &mut far);
             }
@@ -227,17 +251,19 @@ impl Octree {
         if mask(t0, t1, |a, b| a <= b) & p.live == 0 {
             return;
         }
-        let entries = &mut stack.entries;
-        entries.clear();
-        entries.push(PacketEntry {
+        let entries = &mut stack.entries[..];
+        entries[0] = PacketEntry {
             min: lo,
             t0,
             t1,
             node: 0,
             level: 0,
-        });
+        };
+        let mut top = 1;
         let mut mailbox = LaneMailbox([(u32::MAX, 0); 16]);
-        while let Some(e) = entries.pop() {
+        while top > 0 {
+            top -= 1;
+            let e = entries[top];
             let limit = visitor.limit();
             let active = open_before(e.t0, e.t1, limit) & p.live;
             if active == 0 {
@@ -259,8 +285,7 @@ impl Octree {
             visitor.counter().add_lanes(0, lanes, 0);
             let h = self.sides[(e.level + 1) as usize & LEVEL_MASK];
             let mid = [e.min[0] + h, e.min[1] + h, e.min[2] + h];
-            let t_mid: [F64s<N>; 3] =
-                std::array::from_fn(|k| std::array::from_fn(|i| (mid[k] - o[k][i]) * inv[k][i]));
+            let t_mid: [F64s<N>; 3] = per_axis!(|k| lanes!(N, |i| (mid[k] - o[k][i]) * inv[k][i]));
             let cell = Cell {
                 e: &e,
                 h,
@@ -273,14 +298,14 @@ impl Octree {
             };
             // The octants by their far bits (those past a mid-plane along
             // the rays), farthest first, so the nearest is popped next.
-            cell.push::<7, _>(entries, visitor);
-            cell.push::<3, _>(entries, visitor);
-            cell.push::<5, _>(entries, visitor);
-            cell.push::<6, _>(entries, visitor);
-            cell.push::<1, _>(entries, visitor);
-            cell.push::<2, _>(entries, visitor);
-            cell.push::<4, _>(entries, visitor);
-            cell.push::<0, _>(entries, visitor);
+            cell.push::<7, _>(entries, &mut top, visitor);
+            cell.push::<3, _>(entries, &mut top, visitor);
+            cell.push::<5, _>(entries, &mut top, visitor);
+            cell.push::<6, _>(entries, &mut top, visitor);
+            cell.push::<1, _>(entries, &mut top, visitor);
+            cell.push::<2, _>(entries, &mut top, visitor);
+            cell.push::<4, _>(entries, &mut top, visitor);
+            cell.push::<0, _>(entries, &mut top, visitor);
         }
     }
 }
@@ -296,7 +321,7 @@ struct Cell<'a, const N: usize> {
     active: u32,
     negative: u32,
     node_mask: u32,
-    first_child: super::node::Node,
+    first_child: Node,
 }
 
 impl<const N: usize> Cell<'_, N> {
@@ -307,7 +332,8 @@ impl<const N: usize> Cell<'_, N> {
     #[inline(always)]
     fn push<const FAR: u32, V: PacketVisitor<N>>(
         &self,
-        entries: &mut Vec<PacketEntry<N>>,
+        entries: &mut [PacketEntry<N>],
+        top: &mut usize,
         visitor: &mut V,
     ) {
         let mut c0 = self.e.t0;
@@ -333,7 +359,7 @@ impl<const N: usize> Cell<'_, N> {
         }
         let (e, h) = (self.e, self.h);
         let bit = |k: usize| (c >> k & 1) as f64;
-        entries.push(PacketEntry {
+        entries[*top] = PacketEntry {
             min: [
                 e.min[0] + h * bit(0),
                 e.min[1] + h * bit(1),
@@ -343,6 +369,7 @@ impl<const N: usize> Cell<'_, N> {
             t1: c1,
             node: self.first_child.child(c),
             level: e.level + 1,
-        });
+        };
+        *top += 1;
     }
 }

@@ -2,9 +2,9 @@
 //! ray, and what it says of itself (statistics, cells for the overlay).
 //! Building is `build.rs`'s, the traversal `walk.rs`'s.
 
+use super::node::LEVEL_MASK;
 use super::node::{Cell, Node};
 use super::params::{OctreeCell, OctreeParams, OctreeStats};
-use super::walk::LEVEL_MASK;
 use crate::math::Aabb;
 
 #[derive(Clone, Debug)]

@@ -2,10 +2,11 @@
 //! Ureña & Lastra (2000), iteratively on a per-thread stack, for the
 //! closest hit and for shadow rays.
 
-use super::super::primitives::{
+use super::node::LEVEL_MASK;
+use super::tree::Octree;
+use crate::accel::primitives::{
     ClosestHit, Primitives, ShadowCrossings, test_closest, test_occlusion,
 };
-use super::tree::Octree;
 use crate::limits::MAX_OCTREE_DEPTH;
 use crate::shapes::PreparedRay;
 use crate::stats::Counter;
@@ -243,9 +244,6 @@ struct Entry {
 /// waiting, plus the cell being entered (a power of two, so indices are
 /// masked instead of bounds-checked).
 const STACK_CAPACITY: usize = (3 * MAX_OCTREE_DEPTH as usize + 4).next_power_of_two();
-
-/// Levels the side table holds (masked the same way).
-pub(super) const LEVEL_MASK: usize = (MAX_OCTREE_DEPTH as usize + 2).next_power_of_two() - 1;
 
 /// The cells a walk has still to visit: scratch space the caller owns
 /// (one per tile of the image), so no ray sets it up.
