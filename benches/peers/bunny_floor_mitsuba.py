@@ -105,7 +105,8 @@ def choose_variant(wanted, probe=True):
     return "scalar_rgb", reason
 
 
-def scene_dict(width, height, spp):
+def scene_dict(width, height, spp, framing="fill"):
+    eye, lookat = common.FRAMINGS[framing]
     verts, _faces = common.load_obj(common.BUNNY_OBJ)
     min_y = float(verts[:, 1].min()) * common.BUNNY_SCALE
     centre = (verts.min(axis=0) + verts.max(axis=0)) * 0.5 * common.BUNNY_SCALE
@@ -125,7 +126,7 @@ def scene_dict(width, height, spp):
             "type": "perspective",
             "fov_axis": "y",
             "fov": common.FOV_DEG,
-            "to_world": T().look_at(origin=list(common.EYE), target=list(common.LOOKAT), up=list(common.UP)),
+            "to_world": T().look_at(origin=list(eye), target=list(lookat), up=list(common.UP)),
             "sampler": {"type": "independent", "sample_count": spp},
             "film": {
                 "type": "hdrfilm",
@@ -170,6 +171,8 @@ def main():
     ap.add_argument("--width", type=int, default=common.WIDTH)
     ap.add_argument("--height", type=int, default=common.HEIGHT)
     ap.add_argument("--variant", default="llvm_ad_rgb")
+    ap.add_argument("--framing", choices=sorted(common.FRAMINGS), default="fill",
+                    help="camera: fill (bunny_floor.toml) or small (bunny_floor_small.toml)")
     ap.add_argument("--out", help="write the last image here (.exr, or .png tonemapped by Mitsuba)")
     ap.add_argument("--no-probe", action="store_true",
                     help="skip the child-process test render of the variant")
@@ -189,7 +192,7 @@ def main():
         dr.set_thread_count(args.threads)
 
     t0 = time.perf_counter()
-    d, min_y = scene_dict(args.width, args.height, args.spp)
+    d, min_y = scene_dict(args.width, args.height, args.spp, args.framing)
     scene = mi.load_dict(d)
     load_s = time.perf_counter() - t0
 

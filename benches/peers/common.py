@@ -32,6 +32,14 @@ HEIGHT = 768
 BUNNY_SCALE = 0.1
 LIGHT = (-2.0, 4.0, 4.0)
 
+# Camera (eye, lookat) of the bunny-on-floor scene: "fill" is bunny_floor.toml
+# (the bunny fills the frame), "small" bunny_floor_small.toml (the bunny a
+# quarter of the frame's height, most rays on the floor).
+FRAMINGS = {
+    "fill": (EYE, LOOKAT),
+    "small": ((0.0, 1.6, 5.5), (0.0, 0.3, 0.0)),
+}
+
 
 def load_obj(path):
     """Positions (n, 3) float64 and triangles (m, 3) int64, zero-based.

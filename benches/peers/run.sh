@@ -6,7 +6,10 @@
 #
 # Environment:
 #   GLINT   glint binary (default target/release/glint; this script never builds it)
-#   PYTHON  Python interpreter (default python3)
+#   PYTHON  Python interpreter with numpy, embreex, mitsuba and drjit (default:
+#           a virtual environment the script creates and fills on first use,
+#           in $GLINT_PEERS_VENV, default ~/.cache/glint/peers-venv; the
+#           system Python is never touched)
 #   REPS    glint repetitions, median taken (default 5)
 #
 # Prints a markdown table: workload, glint, peer, ratio (glint speed / peer
@@ -17,7 +20,8 @@ set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."   # repository root
 THREADS="${1:-2}"
 GLINT="${GLINT:-target/release/glint}"
-PYTHON="${PYTHON:-python3}"
+VENV="${GLINT_PEERS_VENV:-${XDG_CACHE_HOME:-$HOME/.cache}/glint/peers-venv}"
+PYTHON="${PYTHON:-$VENV/bin/python}"
 REPS="${REPS:-5}"
 PEERS=benches/peers
 OUT="$(mktemp -d /tmp/peers-run.XXXXXX)"
@@ -39,6 +43,13 @@ fi
 PIP_PACKAGES=(numpy "embreex==4.4.0.post1" "mitsuba==3.9.1" "drjit==1.5.0")
 
 ensure_python_deps() {
+    if [[ "$PYTHON" == "$VENV/bin/python" && ! -x "$PYTHON" ]]; then
+        echo "creating a virtual environment for the peers in $VENV" >&2
+        python3 -m venv "$VENV" >&2 || {
+            echo "python3 -m venv failed (on Debian: apt-get install python3-venv)" >&2
+            exit 1
+        }
+    fi
     if ! "$PYTHON" -c "import numpy, embreex, mitsuba, drjit" 2>/dev/null; then
         echo "installing Python packages: ${PIP_PACKAGES[*]}" >&2
         "$PYTHON" -m pip install --quiet "${PIP_PACKAGES[@]}" >&2
@@ -97,12 +108,14 @@ glint_bunny_primary() {
     json "$OUT/glint-bunny.json" 'str(j[0]["octree_on"]["render_s"]) + " " + str(j[0]["octree_on"]["mrays_per_s"])'
 }
 
-# benches/peers/bunny_floor.toml: 16 samples per pixel, eye + shadow rays.
+# benches/peers/bunny_floor.toml (FRAMING fill) or bunny_floor_small.toml
+# (small): 16 samples per pixel, eye + shadow rays.
 glint_bunny_floor() {
-    local t="$1"
-    "$GLINT" bench "$PEERS/bunny_floor.toml" --octree-only --repeat "$REPS" --threads "$t" \
-        --format json >"$OUT/glint-floor.json"
-    json "$OUT/glint-floor.json" 'str(j[0]["octree_on"]["render_s"]) + " " + str(j[0]["octree_on"]["mrays_per_s"])'
+    local t="$1" framing="$2" scene="$PEERS/bunny_floor.toml"
+    [[ "$framing" == small ]] && scene="$PEERS/bunny_floor_small.toml"
+    "$GLINT" bench "$scene" --octree-only --repeat "$REPS" --threads "$t" \
+        --format json >"$OUT/glint-floor-$framing.json"
+    json "$OUT/glint-floor-$framing.json" 'str(j[0]["octree_on"]["render_s"]) + " " + str(j[0]["octree_on"]["mrays_per_s"])'
 }
 # <<< END OF GLINT INVOCATION >>>
 # ---------------------------------------------------------------------------
@@ -118,10 +131,16 @@ echo "embree: bunny primary rays ..." >&2
 "$PYTHON" "$PEERS/bunny_embree.py" --threads "$THREADS" --runs 5 \
     --glint-stats "$OUT/glint-bunny-0.json" >"$OUT/embree.json"
 
-echo "glint: bunny on floor, 16 spp ..." >&2
-read -r G_FLOOR_S G_FLOOR_MRAYS < <(glint_bunny_floor "$THREADS")
-echo "mitsuba: bunny on floor, 16 spp ..." >&2
+echo "glint: bunny on floor, 16 spp, bunny filling the frame ..." >&2
+read -r G_FLOOR_S G_FLOOR_MRAYS < <(glint_bunny_floor "$THREADS" fill)
+echo "mitsuba: bunny on floor, 16 spp, bunny filling the frame ..." >&2
 "$PYTHON" "$PEERS/bunny_floor_mitsuba.py" --threads "$THREADS" --runs 3 >"$OUT/mitsuba.json"
+echo "glint: bunny on floor, 16 spp, bunny small in the frame ..." >&2
+read -r G_SMALL_S G_SMALL_MRAYS < <(glint_bunny_floor "$THREADS" small)
+echo "mitsuba: bunny on floor, 16 spp, bunny small in the frame ..." >&2
+"$PYTHON" "$PEERS/bunny_floor_mitsuba.py" --threads "$THREADS" --runs 3 --framing small \
+    >"$OUT/mitsuba-small.json"
+M_SMALL_S="$(json "$OUT/mitsuba-small.json" 'j["seconds"]')"
 
 E_S="$(json "$OUT/embree.json" 'j["seconds"]')"
 E_MRAYS="$(json "$OUT/embree.json" 'j["mrays_per_s"]')"
@@ -135,20 +154,24 @@ M_WARM="$(json "$OUT/mitsuba.json" 'j["warmup_s"]')"
 M_FALLBACK="$(json "$OUT/mitsuba.json" 'j.get("fallback_reason") or ""')"
 
 "$PYTHON" - "$THREADS" "$G_BUNNY_S" "$G_BUNNY_MRAYS" "$E_S" "$E_MRAYS" \
-    "$G_FLOOR_S" "$G_FLOOR_MRAYS" "$M_S" "$M_VARIANT" <<'EOF'
+    "$G_FLOOR_S" "$G_FLOOR_MRAYS" "$M_S" "$M_VARIANT" "$G_SMALL_S" "$G_SMALL_MRAYS" "$M_SMALL_S" <<'EOF'
 import sys
 t = sys.argv[1]
 g_bunny_s, g_bunny_mrays, e_s, e_mrays, g_floor_s, g_floor_mrays, m_s = map(float, sys.argv[2:9])
 m_variant = sys.argv[9]
+g_small_s, g_small_mrays, m_small_s = map(float, sys.argv[10:13])
 print()
 print(f"| workload ({t} threads) | glint | peer | ratio (glint/peer speed) |")
 print("|---|---|---|---|")
 print(f"| bunny primary rays, 1024x768, 1 spp (Embree 4, embreex) "
       f"| {g_bunny_mrays:.2f} Mrays/s ({g_bunny_s * 1e3:.1f} ms) "
       f"| {e_mrays:.2f} Mrays/s ({e_s * 1e3:.1f} ms) | {g_bunny_mrays / e_mrays:.3f} |")
-print(f"| bunny on floor, direct + shadows, 1024x768, 16 spp (Mitsuba 3 {m_variant}) "
+print(f"| bunny on floor, bunny fills the frame, direct + shadows, 1024x768, 16 spp (Mitsuba 3 {m_variant}) "
       f"| {g_floor_s:.3f} s ({g_floor_mrays:.2f} Mrays/s) "
       f"| {m_s:.3f} s | {m_s / g_floor_s:.3f} |")
+print(f"| bunny on floor, bunny small in the frame, same settings (Mitsuba 3 {m_variant}) "
+      f"| {g_small_s:.3f} s ({g_small_mrays:.2f} Mrays/s) "
+      f"| {m_small_s:.3f} s | {m_small_s / g_small_s:.3f} |")
 EOF
 echo
 echo "- primary hits: glint $G_HITS, Embree $E_HITS (difference $((E_HITS - G_HITS))); Embree robust mode: $E_ROBUST"
