@@ -7,7 +7,7 @@ use crate::accel::ClosestHit;
 use crate::math::{Color, DVec3, Ray, offset_ray_origin, reflect, refract};
 use crate::ray_tree::{HitRecord, RayKind, RayRecorder, ShadowRecord, ShadowVerdict};
 use crate::settings::Protocol;
-use crate::shapes::PreparedRay;
+use crate::shapes::{PreparedRay, Shape};
 use crate::stats::{Counter, RayCounts};
 
 use super::renderer::{Query, Renderer};
@@ -16,6 +16,12 @@ use super::renderer::{Query, Renderer};
 /// with what material.
 pub(super) struct ShadingPoint {
     point: DVec3,
+    /// Where shadow rays start before their offset: on a smooth-shaded
+    /// triangle (glint's protocol) the smooth surface above `point`.
+    shadow_point: DVec3,
+    /// Shaded with interpolated normals under glint's protocol: the light
+    /// test asks the shading normal alone.
+    smooth: bool,
     /// The geometric normal turned towards the incoming ray.
     facing: DVec3,
     /// The shading normal on the same side as `facing`.
@@ -92,6 +98,14 @@ impl Renderer<'_> {
             normal = facing;
         }
         let point = surface.point;
+        let shadow_point = match (self.settings.protocol, shape) {
+            (Protocol::Glint, Shape::Triangle(t)) => {
+                t.smooth_point(&hit.hit, point, facing, &scene.vertex_normals)
+            }
+            _ => point,
+        };
+        let smooth = self.settings.protocol == Protocol::Glint
+            && matches!(shape, Shape::Triangle(t) if t.has_vertex_normals());
         rec.material(material);
         rec.hit(|| HitRecord {
             object: hit.shape,
@@ -104,6 +118,8 @@ impl Renderer<'_> {
         });
         ShadingPoint {
             point,
+            shadow_point,
+            smooth,
             facing,
             normal,
             entering,
@@ -154,16 +170,22 @@ impl Renderer<'_> {
     /// ray came from.
     #[inline(always)]
     pub(super) fn shadow_origin(&self, at: &ShadingPoint) -> DVec3 {
-        offset_ray_origin(at.point, at.facing, self.floor_scale)
+        offset_ray_origin(at.shadow_point, at.facing, self.floor_scale)
     }
 
     /// The direction to `light` from `origin`, its distance and the cosine
     /// at the surface; `None` where the surface faces away from the light
     /// (or the light sits on the origin): then it gets neither light nor a
-    /// shadow ray. glint asks both normals: an interpolated normal can face
-    /// the light where the surface itself does not. The SPD asks the shading
-    /// normal alone (its published shadow counts on the smooth-shaded
-    /// teapot match only that way).
+    /// shadow ray. On a flat surface glint asks the geometric normal too
+    /// (an interpolated normal can face the light where the surface itself
+    /// does not); on a smooth-shaded triangle the shading normal alone, as
+    /// its shadow ray starts on the smooth surface ([`Triangle::smooth_point`]),
+    /// so the terminator follows the smooth surface, not whole facets. The
+    /// SPD asks the shading normal alone and starts shadow rays on the
+    /// facet (its published shadow counts on the smooth-shaded teapot match
+    /// only that way).
+    ///
+    /// [`Triangle::smooth_point`]: crate::shapes::Triangle::smooth_point
     #[inline(always)]
     pub(super) fn toward_light(
         &self,
@@ -179,6 +201,7 @@ impl Renderer<'_> {
         let l = to_light / distance;
         let n_dot_l = at.normal.dot(l);
         let faces_away = match self.settings.protocol {
+            Protocol::Glint if at.smooth => n_dot_l <= 0.0,
             Protocol::Glint => n_dot_l <= 0.0 || at.facing.dot(l) <= 0.0,
             Protocol::Spd => n_dot_l <= 0.0,
         };

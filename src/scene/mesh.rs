@@ -1,7 +1,10 @@
-//! Wavefront OBJ meshes (through `tobj`), placed by scale, rotation and translation.
+//! Wavefront OBJ meshes and their MTL materials, placed by scale, rotation
+//! and translation.
 
 use std::path::Path;
 
+use super::mtl::{self, MtlEntry};
+use super::obj::{self, NO_NORMAL, SkippedElements};
 use super::polygon::{DroppedPolygons, triangulate};
 use crate::math::DVec3;
 
@@ -41,116 +44,146 @@ pub struct LoadedMesh {
     pub triangles: Vec<[DVec3; 3]>,
     /// Per-triangle vertex normals when the mesh is smooth shaded.
     pub normals: Option<Vec<[DVec3; 3]>>,
+    /// Each triangle's material: an index into `material_names`.
+    pub triangle_materials: Vec<u32>,
+    /// The `usemtl` names in order; index 0 (empty) is the faces with none.
+    pub material_names: Vec<String>,
+    /// The file's `mtllib` arguments.
+    pub libraries: Vec<String>,
     /// Faces that were not simple polygons or had no area.
     pub dropped_polygons: DroppedPolygons,
+    /// Elements glint does not render, counted.
+    pub skipped: SkippedElements,
 }
 
-/// Parses OBJ bytes. `smooth`: `None` uses the file's normals when it has
-/// them; `Some(true)` computes area-weighted vertex normals when it has none;
-/// `Some(false)` shades flat.
+/// Parses OBJ bytes (every refusal names its line). `smooth`: `None` uses
+/// the file's normals when it has them; `Some(true)` computes area-weighted
+/// vertex normals when it has none; `Some(false)` shades flat.
 pub fn parse_obj(
     bytes: &[u8],
     smooth: Option<bool>,
     placement: &Placement,
 ) -> Result<LoadedMesh, String> {
-    // tobj's own triangulation splits quads on a fixed diagonal and larger
-    // faces as a fan, which is wrong for concave faces: faces are read
-    // whole and ear-clipped here.
-    let options = tobj::LoadOptions {
-        triangulate: false,
-        single_index: true,
-        ignore_points: true,
-        ignore_lines: true,
-    };
-    let mut reader = std::io::BufReader::new(bytes);
-    let (models, _) = tobj::load_obj_buf(&mut reader, &options, |_| Ok(Default::default()))
-        .map_err(|e| format!("not a valid OBJ file: {e}"))?;
+    let data = obj::parse(bytes).map_err(|e| e.to_string())?;
     let rotation = placement.rotation();
     let place = |p: DVec3| rotation * (p * placement.scale) + placement.translate;
+    let positions: Vec<DVec3> = data.positions.iter().map(|&p| place(p)).collect();
+    if !positions.iter().all(|p| p.is_finite()) {
+        return Err(
+            "vertex coordinates overflow once placed (scale or translate too large)".into(),
+        );
+    }
+    let normals: Vec<DVec3> = data.normals.iter().map(|&n| rotation * n).collect();
     let mut triangles = Vec::new();
-    let mut normals = Vec::new();
+    let mut triangle_normals = Vec::new();
+    let mut triangle_materials = Vec::new();
     let mut any_normals = false;
     let mut dropped_polygons = DroppedPolygons::default();
-    for model in &models {
-        let m = &model.mesh;
-        let position = |i: u32| -> Result<DVec3, String> {
-            let i = i as usize * 3;
-            m.positions
-                .get(i..i + 3)
-                .map(|p| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
-                .ok_or_else(|| format!("vertex index {} out of range", i / 3 + 1))
-        };
-        let has_normals = m.normals.len() == m.positions.len() && !m.normals.is_empty();
-        any_normals |= has_normals;
-        let normal = |i: u32| {
-            let i = i as usize * 3;
-            rotation
-                * DVec3::new(
-                    m.normals[i] as f64,
-                    m.normals[i + 1] as f64,
-                    m.normals[i + 2] as f64,
-                )
-        };
-        // Every face is a triangle when the file has no larger ones.
-        let arities: Vec<usize> = if m.face_arities.is_empty() {
-            vec![3; m.indices.len() / 3]
+    let mut skipped = data.skipped.clone();
+    let mut face: Vec<(u32, u32)> = Vec::new();
+    for f in &data.faces {
+        // Repeated vertices removed (the first of each kept): a face that
+        // lists its four corners 234 times is a quad, not 936 triangles.
+        face.clear();
+        let listed = &data.corners[f.start as usize..(f.start + f.len) as usize];
+        for &corner in listed {
+            if !face.iter().any(|&(p, _)| p == corner.0) {
+                face.push(corner);
+            }
+        }
+        if face.len() < listed.len() {
+            skipped.faces_with_repeated_vertices += 1;
+        }
+        if face.len() < 3 {
+            skipped.short_faces += 1;
+            continue;
+        }
+        let corners: Vec<DVec3> = face.iter().map(|&(p, _)| positions[p as usize]).collect();
+        let pieces = if face.len() == 3 {
+            vec![[0, 1, 2]]
         } else {
-            m.face_arities.iter().map(|&a| a as usize).collect()
-        };
-        let mut start = 0;
-        for arity in arities {
-            let face = m
-                .indices
-                .get(start..start + arity)
-                .ok_or("face indices out of range")?;
-            start += arity;
-            let corners = face
-                .iter()
-                .map(|&i| position(i).map(place))
-                .collect::<Result<Vec<DVec3>, String>>()?;
-            if !corners.iter().all(|p| p.is_finite()) {
-                return Err("vertex coordinates must be finite".into());
-            }
-            let pieces = if arity == 3 {
-                vec![[0, 1, 2]]
-            } else {
-                match triangulate(&corners) {
-                    Ok(t) => t,
-                    Err(defect) => {
-                        dropped_polygons.record(defect);
-                        continue;
-                    }
+            // Faces are ear-clipped, not fanned: concave faces exist.
+            match triangulate(&corners) {
+                Ok(t) => t,
+                Err(defect) => {
+                    dropped_polygons.record(defect);
+                    continue;
                 }
-            };
-            for [a, b, c] in pieces {
-                let (a, b, c) = (a as usize, b as usize, c as usize);
-                triangles.push([corners[a], corners[b], corners[c]]);
-                normals.push(if has_normals {
-                    [normal(face[a]), normal(face[b]), normal(face[c])]
-                } else {
-                    [DVec3::ZERO; 3]
-                });
             }
+        };
+        let has_normals = face.iter().all(|&(_, n)| n != NO_NORMAL);
+        any_normals |= has_normals;
+        for [a, b, c] in pieces {
+            let (a, b, c) = (a as usize, b as usize, c as usize);
+            triangles.push([corners[a], corners[b], corners[c]]);
+            triangle_normals.push(if has_normals {
+                [a, b, c].map(|k| normals[face[k].1 as usize])
+            } else {
+                [DVec3::ZERO; 3]
+            });
+            triangle_materials.push(f.material);
         }
     }
     if triangles.is_empty() {
         return Err(if dropped_polygons.total() > 0 {
             "the mesh has no face that is a simple polygon".into()
         } else {
-            "the mesh has no triangles".into()
+            "the mesh has no faces (lines and points are not rendered)".into()
         });
     }
     let normals = match smooth {
         Some(false) => None,
         None if !any_normals => None,
         Some(true) if !any_normals => Some(computed_vertex_normals(&triangles)),
-        _ => Some(normals),
+        _ => Some(triangle_normals),
     };
     Ok(LoadedMesh {
         triangles,
         normals,
+        triangle_materials,
+        material_names: data.materials,
+        libraries: data.libraries,
         dropped_polygons,
+        skipped,
     })
+}
+
+/// The materials of an OBJ file's `mtllib` libraries, read through `files`
+/// relative to `obj_path`'s folder; a library that cannot be read or parsed
+/// is a note (its materials fall back to the default), not a refusal.
+pub(super) fn read_libraries(
+    libraries: &[String],
+    obj_path: &Path,
+    files: &dyn MeshSource,
+    notes: &mut Vec<String>,
+) -> Vec<MtlEntry> {
+    let folder = obj_path.parent().unwrap_or(Path::new(""));
+    let mut entries = Vec::new();
+    for written in libraries {
+        // One file name with spaces, or several names.
+        let whole = folder.join(written);
+        let names: Vec<std::path::PathBuf> = if files.read(&whole).is_ok() {
+            vec![whole]
+        } else {
+            written.split_whitespace().map(|n| folder.join(n)).collect()
+        };
+        for path in names {
+            match files.read(&path) {
+                Ok(bytes) => match mtl::parse(&bytes) {
+                    Ok(mut found) => entries.append(&mut found),
+                    Err(e) => notes.push(format!(
+                        "{}: {e}; its materials are shown in the default material",
+                        path.display()
+                    )),
+                },
+                Err(e) => notes.push(format!(
+                    "{}: cannot read ({e}); its materials are shown in the default material",
+                    path.display()
+                )),
+            }
+        }
+    }
+    entries
 }
 
 /// Area-weighted vertex normals for a triangle soup, vertices matched by
@@ -207,7 +240,7 @@ mod tests {
 
     #[test]
     fn concave_faces_are_ear_clipped_not_fanned() {
-        // An arrow head given from its reflex vertex: tobj's fixed diagonal
+        // An arrow head given from its reflex vertex: a fixed diagonal
         // (1-3) and a fan from vertex 1 would both fill outside it.
         let arrow = "v 2 1 0\nv 4 0 0\nv 2 3 0\nv 0 0 0\nf 1 2 3 4\n";
         let mesh = parse_obj(arrow.as_bytes(), None, &identity()).unwrap();

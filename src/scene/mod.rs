@@ -1,10 +1,14 @@
 //! A scene as the renderer sees it, and the two file formats that describe it:
-//! glint's own TOML ([`toml_format`]) and Eric Haines's NFF ([`nff`]).
+//! glint's own TOML ([`toml_format`]) and Eric Haines's NFF ([`nff`]); an
+//! OBJ model also opens on its own, in a scene written around it.
 
 pub mod builtin;
 mod mesh;
 mod model;
+mod mtl;
 pub mod nff;
+mod obj;
+mod obj_scene;
 pub mod polygon;
 pub mod toml_format;
 
@@ -13,10 +17,15 @@ use std::sync::Arc;
 
 pub use mesh::{FileSystem, MeshSource};
 pub use model::{ImageSettings, Location, Scene, SceneError};
+pub use obj::SkippedElements;
 pub use polygon::DroppedPolygons;
 
-/// Loads a `.toml` or `.nff` scene file.
+/// Loads a `.toml` or `.nff` scene file, or an `.obj` model as a scene of
+/// its own ([`obj_scene`]).
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
+    if extension(path).as_deref() == Some("obj") {
+        return obj_scene::load(path, &mesh::FileSystem);
+    }
     let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
         path: path.to_owned(),
         source,
@@ -28,17 +37,20 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     load_str(&text, path, &mesh::FileSystem)
 }
 
-/// Parses scene text; `path` names it in errors, chooses the format by its
-/// extension and anchors relative mesh paths.
-pub fn load_str(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, SceneError> {
-    let mut scene = match path
-        .extension()
+fn extension(path: &Path) -> Option<String> {
+    path.extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase)
-        .as_deref()
-    {
+}
+
+/// Parses scene text; `path` names it in errors, chooses the format by its
+/// extension and anchors relative mesh paths. For an `.obj` path the text
+/// is the TOML scene [`load`] wrote around it.
+pub fn load_str(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, SceneError> {
+    let mut scene = match extension(path).as_deref() {
         Some("toml") => toml_format::parse(text, path, files),
         Some("nff") => nff::parse(text, path),
+        Some("obj") => obj_scene::reload(text, path, files),
         _ => Err(SceneError::UnknownFormat {
             path: path.to_owned(),
         }),

@@ -13,6 +13,7 @@ use crate::math::{Aabb, Color, DVec3};
 use crate::settings::{Protocol, RenderSettings, Sides, ViewMode};
 use crate::shapes::{Shape, Triangle};
 
+use super::obj::SkippedElements;
 use super::polygon::{DroppedPolygons, triangulate};
 
 /// Image and recursion settings stored with a scene; command-line flags and
@@ -74,6 +75,15 @@ pub struct Scene {
     pub dropped_triangles: usize,
     /// Polygons dropped while loading: zero area, or not simple.
     pub dropped_polygons: DroppedPolygons,
+    /// OBJ elements glint does not render (lines, points, curves, faces
+    /// with fewer than three distinct vertices), counted.
+    pub skipped_elements: SkippedElements,
+    /// MTL keywords glint does not render (texture maps, bump, emission),
+    /// with the number of materials that use each.
+    pub not_rendered: std::collections::BTreeMap<String, usize>,
+    /// What loading had to tell the user (a material library that could
+    /// not be read, a material no library defines), once each.
+    pub load_notes: Vec<String>,
     /// What the file's colour numbers are: linear light (TOML) or display
     /// values (NFF); a render in the other convention converts them.
     pub color_values: ColorConvention,
@@ -117,9 +127,72 @@ impl Scene {
             vertex_normals: Arc::default(),
             dropped_triangles: 0,
             dropped_polygons: DroppedPolygons::default(),
+            skipped_elements: SkippedElements::default(),
+            not_rendered: Default::default(),
+            load_notes: Vec::new(),
             color_values: ColorConvention::Linear,
             source_text: Arc::from(""),
         }
+    }
+
+    /// What loading dropped, skipped or could not read, one sentence each,
+    /// for the command line's notes and the viewer's messages.
+    pub fn notes(&self) -> Vec<String> {
+        let mut notes = Vec::new();
+        if self.dropped_triangles > 0 {
+            notes.push(format!(
+                "{} degenerate triangles were skipped",
+                self.dropped_triangles
+            ));
+        }
+        let dropped = self.dropped_polygons;
+        if dropped.total() > 0 {
+            notes.push(format!(
+                "{} polygons were skipped ({} with crossing edges, {} with no area)",
+                dropped.total(),
+                dropped.not_simple,
+                dropped.zero_area
+            ));
+        }
+        notes.extend(self.load_notes.iter().cloned());
+        if !self.not_rendered.is_empty() {
+            let listed: Vec<String> = self
+                .not_rendered
+                .iter()
+                .map(|(k, n)| format!("{k} ({n} material{})", if *n == 1 { "" } else { "s" }))
+                .collect();
+            notes.push(format!(
+                "glint does not render these material keys: {}",
+                listed.join(", ")
+            ));
+        }
+        let skipped = &self.skipped_elements;
+        let mut parts = Vec::new();
+        for (n, what) in [
+            (skipped.lines, "lines (l)"),
+            (skipped.points, "points (p)"),
+            (
+                skipped.short_faces,
+                "faces with fewer than 3 distinct vertices",
+            ),
+        ] {
+            if n > 0 {
+                parts.push(format!("{n} {what}"));
+            }
+        }
+        for (k, n) in &skipped.statements {
+            parts.push(format!("{n} `{k}` statements"));
+        }
+        if !parts.is_empty() {
+            notes.push(format!("OBJ elements skipped: {}", parts.join(", ")));
+        }
+        if skipped.faces_with_repeated_vertices > 0 {
+            notes.push(format!(
+                "{} OBJ faces listed a vertex more than once; the repeats were removed",
+                skipped.faces_with_repeated_vertices
+            ));
+        }
+        notes
     }
 
     pub fn push(&mut self, shape: Shape, material: u32) {
@@ -127,16 +200,16 @@ impl Scene {
         Arc::make_mut(&mut self.shape_materials).push(material);
     }
 
-    /// Adds triangles (with optional per-triangle vertex normals), dropping
-    /// degenerate ones.
+    /// Adds triangles (with optional per-triangle vertex normals), each
+    /// with the material `material(i)`, dropping degenerate ones.
     pub(crate) fn push_mesh(
         &mut self,
         triangles: Vec<[DVec3; 3]>,
         normals: Option<Vec<[DVec3; 3]>>,
-        material: u32,
+        material: impl Fn(usize) -> u32,
     ) {
         for (i, vertices) in triangles.into_iter().enumerate() {
-            self.push_triangle(vertices, normals.as_ref().map(|n| n[i]), material);
+            self.push_triangle(vertices, normals.as_ref().map(|n| n[i]), material(i));
         }
     }
 
@@ -265,7 +338,7 @@ pub enum SceneError {
         mesh: PathBuf,
         message: String,
     },
-    #[error("{path}: unknown scene format (expected a .toml or .nff file)")]
+    #[error("{path}: unknown scene format (expected a .toml, .nff or .obj file)")]
     UnknownFormat { path: PathBuf },
 }
 

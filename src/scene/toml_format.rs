@@ -103,7 +103,7 @@ struct ClipFile {
 #[serde(deny_unknown_fields)]
 struct ObjectFile {
     kind: Spanned<String>,
-    material: Spanned<String>,
+    material: Option<Spanned<String>>,
     center: Option<Vec3>,
     radius: Option<Spanned<f64>>,
     point: Option<Vec3>,
@@ -121,6 +121,8 @@ struct ObjectFile {
 struct Context<'a> {
     text: &'a str,
     path: &'a Path,
+    /// How many materials the file defines (meshes add theirs behind).
+    defined_materials: usize,
 }
 
 impl Context<'_> {
@@ -199,7 +201,11 @@ impl Context<'_> {
 }
 
 pub fn parse(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, SceneError> {
-    let cx = Context { text, path };
+    let mut cx = Context {
+        text,
+        path,
+        defined_materials: 0,
+    };
     // Syntax errors have a place but no key; type errors get their key path
     // (`objects[0].radius`, the style of every other error) from
     // serde_path_to_error and their place from toml's span.
@@ -373,6 +379,7 @@ pub fn parse(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, S
     let mut scene = Scene::empty(path.display().to_string(), camera, image);
     scene.octree_enabled = file.octree.enabled.unwrap_or(true);
     scene.octree_params = octree_params;
+    cx.defined_materials = materials.len();
     scene.materials = materials;
     scene.lights = lights;
     for (i, obj) in file.objects.iter().enumerate() {
@@ -390,22 +397,43 @@ fn add_object(
 ) -> Result<(), SceneError> {
     let key = |k: &str| format!("objects[{index}].{k}");
     let kind = obj.kind.get_ref().as_str();
-    let material = scene
-        .materials
-        .iter()
-        .position(|m| m.name == *obj.material.get_ref())
-        .ok_or_else(|| {
-            let known: Vec<&str> = scene.materials.iter().map(|m| m.name.as_str()).collect();
-            cx.error(
-                obj.material.span(),
+    // Only the file's own materials: a mesh's MTL materials are appended
+    // behind them as meshes load.
+    let named = match &obj.material {
+        Some(name) => Some(
+            scene.materials[..cx.defined_materials]
+                .iter()
+                .position(|m| m.name == *name.get_ref())
+                .ok_or_else(|| {
+                    let known: Vec<&str> = scene.materials[..cx.defined_materials]
+                        .iter()
+                        .map(|m| m.name.as_str())
+                        .collect();
+                    cx.error(
+                        name.span(),
+                        &key("material"),
+                        format!(
+                            "no material named `{}` (defined: {})",
+                            name.get_ref(),
+                            known.join(", ")
+                        ),
+                    )
+                })? as u32,
+        ),
+        None => None,
+    };
+    let material = match (named, kind) {
+        (Some(m), _) => m,
+        // A mesh without `material` uses its file's own materials.
+        (None, "mesh") => u32::MAX,
+        (None, _) => {
+            return Err(cx.error(
+                obj.kind.span(),
                 &key("material"),
-                format!(
-                    "no material named `{}` (defined: {})",
-                    obj.material.get_ref(),
-                    known.join(", ")
-                ),
-            )
-        })? as u32;
+                format!("a {kind} needs `material` (only a mesh may use its file's materials)"),
+            ));
+        }
+    };
 
     // Which keys each kind takes; anything else present is a mistake.
     let allowed: &[&str] = match kind {
@@ -581,11 +609,84 @@ fn add_object(
             .map_err(mesh_error)?;
             scene.dropped_polygons.zero_area += mesh.dropped_polygons.zero_area;
             scene.dropped_polygons.not_simple += mesh.dropped_polygons.not_simple;
-            scene.push_mesh(mesh.triangles, mesh.normals, material);
+            scene.skipped_elements.add(&mesh.skipped);
+            if named.is_some() {
+                scene.push_mesh(mesh.triangles, mesh.normals, |_| material);
+            } else {
+                let slots = mesh_materials(scene, &mesh, &mesh_path, files);
+                let per_triangle = &mesh.triangle_materials;
+                scene.push_mesh(mesh.triangles, mesh.normals, |i| {
+                    slots[per_triangle[i] as usize]
+                });
+            }
         }
         _ => unreachable!("kinds were checked above"),
     }
     Ok(())
+}
+
+/// The scene's material index for each of `mesh`'s `usemtl` slots: its
+/// libraries' materials, added to the scene once each (named after the
+/// MTL, made unique), and the default material for faces with none or
+/// with a name no library defines.
+fn mesh_materials(
+    scene: &mut Scene,
+    mesh: &super::mesh::LoadedMesh,
+    mesh_path: &Path,
+    files: &dyn MeshSource,
+) -> Vec<u32> {
+    let entries =
+        super::mesh::read_libraries(&mesh.libraries, mesh_path, files, &mut scene.load_notes);
+    for (k, n) in super::mtl::not_rendered(&entries) {
+        *scene.not_rendered.entry(k).or_default() += n;
+    }
+    let add = |scene: &mut Scene, material: Material| -> u32 {
+        let mut name = material.name.clone();
+        let mut k = 2;
+        while scene.materials.iter().any(|m| m.name == name) {
+            name = format!("{} ({k})", material.name);
+            k += 1;
+        }
+        scene.materials.push(Material { name, ..material });
+        scene.materials.len() as u32 - 1
+    };
+    let mut default = None;
+    let mut slots = Vec::with_capacity(mesh.material_names.len());
+    let used: Vec<bool> = {
+        let mut used = vec![false; mesh.material_names.len()];
+        for &m in &mesh.triangle_materials {
+            used[m as usize] = true;
+        }
+        used
+    };
+    for (slot, name) in mesh.material_names.iter().enumerate() {
+        let entry = (slot > 0)
+            .then(|| entries.iter().find(|e| e.name == *name))
+            .flatten();
+        let index = match entry {
+            Some(e) if used[slot] => add(scene, e.to_material(e.name.clone())),
+            _ if !used[slot] => u32::MAX,
+            _ => {
+                if slot > 0 {
+                    scene.load_notes.push(format!(
+                        "{}: no material library defines `{name}`; its faces use the default material",
+                        mesh_path.display()
+                    ));
+                }
+                *default.get_or_insert_with(|| {
+                    add(
+                        scene,
+                        Material {
+                            name: "default".into(),
+                            ..Material::default()
+                        },
+                    )
+                })
+            }
+        };
+        slots.push(index);
+    }
+    slots
 }
 
 #[cfg(test)]

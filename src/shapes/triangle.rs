@@ -119,6 +119,42 @@ impl Triangle {
     pub fn bounds(&self) -> Aabb {
         Aabb::from_points(&self.vertices)
     }
+
+    /// Whether the triangle is shaded with vertex normals.
+    pub fn has_vertex_normals(&self) -> bool {
+        self.vertex_normals != NO_NORMALS
+    }
+
+    /// The point of the smooth surface that the vertex normals describe,
+    /// above the hit `point` on the flat triangle, on the side `side`; the
+    /// hit itself on a flat-shaded triangle. Shadow rays from there do not
+    /// see the facet's own plane cut across a smooth terminator (Hanika,
+    /// "Hacking the shadow terminator", Ray Tracing Gems II, 2021: each
+    /// vertex's tangent plane lifts the point by how far it lies below it,
+    /// and the lifts are blended by the barycentric coordinates).
+    pub fn smooth_point(
+        &self,
+        hit: &ShapeHit,
+        point: DVec3,
+        side: DVec3,
+        vertex_normals: &[[DVec3; 3]],
+    ) -> DVec3 {
+        let Some(normals) = vertex_normals.get(self.vertex_normals as usize) else {
+            return point;
+        };
+        let weights = [1.0 - hit.b1 - hit.b2, hit.b1, hit.b2];
+        let mut lift = DVec3::ZERO;
+        for k in 0..3 {
+            let n = normals[k].normalize_or_zero();
+            let n = if n.dot(side) < 0.0 { -n } else { n };
+            let below = (self.vertices[k] - point).dot(n);
+            if below > 0.0 {
+                lift += weights[k] * below * n;
+            }
+        }
+        let lifted = point + lift;
+        if lifted.is_finite() { lifted } else { point }
+    }
 }
 
 /// Exact triangle/box overlap by the separating axis theorem

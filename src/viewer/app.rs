@@ -481,6 +481,9 @@ impl GlintApp {
             Ok(()) => {
                 self.edit.source = source;
                 self.say(format!("opened {}", self.edit.scene.name), false);
+                for note in self.edit.scene.notes() {
+                    self.say(format!("note: {note}"), false);
+                }
             }
             Err(e) => self.say(format!("cannot open: {e:#}"), true),
         }
@@ -513,7 +516,7 @@ impl GlintApp {
             return;
         }
         if let Some(path) = rfd::FileDialog::new()
-            .add_filter("scenes", &["toml", "nff"])
+            .add_filter("scenes and models", &["toml", "nff", "obj"])
             .pick_file()
         {
             self.open(path);

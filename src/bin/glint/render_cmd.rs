@@ -154,6 +154,14 @@ struct RenderStats {
     dropped_degenerate_triangles: usize,
     /// Polygons dropped at load: of zero area, or not simple.
     dropped_polygons: glint::scene::DroppedPolygons,
+    /// OBJ elements not rendered (lines, points, short faces, other
+    /// statements), counted.
+    skipped_elements: glint::scene::SkippedElements,
+    /// MTL keys not rendered, with the number of materials using each.
+    not_rendered: std::collections::BTreeMap<String, usize>,
+    /// What loading had to say (unreadable material libraries, undefined
+    /// material names).
+    load_notes: Vec<String>,
     #[serde(skip_serializing_if = "Option::is_none")]
     octree_stats: Option<OctreeStats>,
     /// With `--view cost` or `cost-steps`: the per-pixel count's range.
@@ -383,7 +391,7 @@ fn report(
             _ => String::new(),
         };
         eprintln!(
-            "wrote {} ({}x{}{written}) in {:.2} s",
+            "wrote {} ({}x{}{written}) in {:.2} s: load {:.2} s, octree build {:.2} s, render {:.2} s",
             if output.as_os_str() == "-" {
                 "standard output".to_string()
             } else {
@@ -391,30 +399,22 @@ fn report(
             },
             frame.width,
             frame.height,
+            job.load_s + job.build_s + render_s,
+            job.load_s,
+            job.build_s,
             render_s
         );
     }
-
-    if scene.dropped_triangles > 0 {
-        eprintln!(
-            "note: {} degenerate triangles were skipped",
-            scene.dropped_triangles
-        );
-    }
-    let dropped = scene.dropped_polygons;
-    if dropped.total() > 0 {
-        eprintln!(
-            "note: {} polygons were skipped ({} with crossing edges, {} with no area)",
-            dropped.total(),
-            dropped.not_simple,
-            dropped.zero_area
-        );
+    for note in scene.notes() {
+        eprintln!("note: {note}");
     }
     if octree.stats().leaves_stopped_by_budget > 0 {
         eprintln!(
-            "note: the octree reached its memory budget ({} MiB): {} nodes stayed leaves; \
-             --octree-memory-budget raises it",
+            "note: the octree build reached its memory budget of {} MiB (nodes, references and \
+             the cells still to split, held at once while building; the finished tree takes {:.1} MiB): \
+             {} cells stayed leaves; --octree-memory-budget raises it",
             scene.octree_params.memory_budget_mib,
+            octree.stats().memory_bytes as f64 / (1024.0 * 1024.0),
             octree.stats().leaves_stopped_by_budget
         );
     }
@@ -460,6 +460,9 @@ fn report(
         nonfinite_samples: counts.nonfinite_samples,
         dropped_degenerate_triangles: scene.dropped_triangles,
         dropped_polygons: scene.dropped_polygons,
+        skipped_elements: scene.skipped_elements.clone(),
+        not_rendered: scene.not_rendered.clone(),
+        load_notes: scene.load_notes.clone(),
         octree_stats: settings.use_octree.then(|| octree.stats()),
         cost_per_pixel: frame.cost_summary().map(|c| CostJson {
             min: c.min,

@@ -1,0 +1,294 @@
+//! Wavefront MTL material libraries, mapped onto glint's Whitted/Phong
+//! material. The mapping (also a table in the README):
+//!
+//! | MTL | glint |
+//! |---|---|
+//! | `Kd` | `color` (clamped to [0, 1]), with `kd = 1` |
+//! | `Ks` | `ks` = mean of `Ks` where the `illum` model has a highlight (2 to 9) |
+//! | `Ns` | `shininess` |
+//! | `d`, `Tr` (= 1 - `d`) | `transparency = 1 - d` |
+//! | `Tf` | `transparency` = mean of `Tf` for refracting models (6, 7) when `d` is 1 |
+//! | `Ni` | `ior` for refracting models (6, 7); `illum 4` and `9` are glass without refraction (`ior = 1`) |
+//! | `illum 0, 1` | diffuse only (`ks = 0`); 0 also without ambient (`ka = 0`) |
+//! | `illum 2` | diffuse and Phong highlight |
+//! | `illum 3, 5, 8` | also mirror reflection, `reflectivity` = mean of `Ks` (5's Fresnel term is not modelled) |
+//! | `illum 4, 6, 7, 9` | also reflection and transparency; 6 and 7 refract (7's Fresnel term is not modelled) |
+//! | `illum 10` | as 1 |
+//!
+//! Texture maps, bump and displacement, emission (`Ke`) and the PBR
+//! extension keys are not rendered: they are listed, never dropped silently.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use crate::material::Material;
+use crate::math::{Color, DVec3};
+
+use super::obj::ObjError;
+
+/// One `newmtl` block as written.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(super) struct MtlEntry {
+    pub name: String,
+    pub kd: Option<Color>,
+    pub ks: Option<Color>,
+    pub tf: Option<Color>,
+    pub ns: Option<f64>,
+    pub ni: Option<f64>,
+    /// Opacity, from `d` or `1 - Tr` (the last one written wins).
+    pub d: Option<f64>,
+    pub illum: Option<u32>,
+    /// Keywords glint does not render, as written (`map_Kd`, `bump`, ...).
+    pub not_rendered: BTreeSet<String>,
+}
+
+/// Keywords read but deliberately without effect: ambient colour (glint's
+/// ambient term is the scene's ambient light times the diffuse colour) and
+/// the sharpness of reflection maps.
+const IGNORED: [&str; 2] = ["Ka", "sharpness"];
+
+/// Parses an MTL file: its materials in order.
+pub(super) fn parse(bytes: &[u8]) -> Result<Vec<MtlEntry>, ObjError> {
+    let mut entries: Vec<MtlEntry> = Vec::new();
+    for (index, raw) in bytes.split(|&b| b == b'\n').enumerate() {
+        let line = index + 1;
+        let err = |message: String| ObjError { line, message };
+        let content = match raw.iter().position(|&b| b == b'#') {
+            Some(hash) => &raw[..hash],
+            None => raw,
+        }
+        .trim_ascii();
+        if content.is_empty() {
+            continue;
+        }
+        let keyword_len = content
+            .iter()
+            .position(u8::is_ascii_whitespace)
+            .unwrap_or(content.len());
+        let keyword = String::from_utf8_lossy(&content[..keyword_len]).into_owned();
+        let rest = content[keyword_len..].trim_ascii();
+        if keyword == "newmtl" {
+            entries.push(MtlEntry {
+                name: String::from_utf8_lossy(rest).into_owned(),
+                ..MtlEntry::default()
+            });
+            continue;
+        }
+        let Some(entry) = entries.last_mut() else {
+            return Err(err(format!("`{keyword}` before the first `newmtl`")));
+        };
+        let numbers = || -> Result<Vec<f64>, ObjError> {
+            rest.split(u8::is_ascii_whitespace)
+                .filter(|t| !t.is_empty())
+                // `d -halo 0.5`: options start with a dash and a letter.
+                .filter(|t| {
+                    !(t.first() == Some(&b'-') && t.get(1).is_some_and(u8::is_ascii_alphabetic))
+                })
+                .map(|t| {
+                    std::str::from_utf8(t)
+                        .ok()
+                        .and_then(|s| s.parse::<f64>().ok())
+                        .filter(|x| x.is_finite())
+                        .ok_or_else(|| {
+                            err(format!(
+                                "`{keyword}`: `{}` is not a finite number",
+                                String::from_utf8_lossy(t)
+                            ))
+                        })
+                })
+                .collect()
+        };
+        let one = || -> Result<f64, ObjError> {
+            numbers()?
+                .first()
+                .copied()
+                .ok_or_else(|| err(format!("`{keyword}` needs a number")))
+        };
+        // `Kd r [g b]`: g and b default to r. `Kd spectral ...` and
+        // `Kd xyz ...` are colours glint cannot read.
+        let color = || -> Result<Option<Color>, ObjError> {
+            if rest.starts_with(b"spectral") || rest.starts_with(b"xyz") {
+                return Ok(None);
+            }
+            let v = numbers()?;
+            match v.as_slice() {
+                [r] => Ok(Some(DVec3::splat(*r))),
+                [r, g, b, ..] => Ok(Some(DVec3::new(*r, *g, *b))),
+                _ => Err(err(format!("`{keyword}` needs one or three numbers"))),
+            }
+        };
+        match keyword.as_str() {
+            "Kd" | "Ks" | "Tf" => match color()? {
+                Some(c) => match keyword.as_str() {
+                    "Kd" => entry.kd = Some(c),
+                    "Ks" => entry.ks = Some(c),
+                    _ => entry.tf = Some(c),
+                },
+                None => {
+                    entry.not_rendered.insert(format!("{keyword} spectral/xyz"));
+                }
+            },
+            "Ns" => entry.ns = Some(one()?),
+            "Ni" => entry.ni = Some(one()?),
+            "d" => entry.d = Some(one()?),
+            "Tr" => entry.d = Some(1.0 - one()?),
+            "illum" => {
+                let i = one()?;
+                if !(0.0..=10.0).contains(&i) || i.fract() != 0.0 {
+                    return Err(err(format!(
+                        "`illum` must be a whole number 0 to 10, got {i}"
+                    )));
+                }
+                entry.illum = Some(i as u32);
+            }
+            // Emission of zero is what most exporters write for "none".
+            "Ke" if color()?.is_some_and(|c| c == DVec3::ZERO) => {}
+            k if IGNORED.contains(&k) => {}
+            _ => {
+                entry.not_rendered.insert(keyword);
+            }
+        }
+    }
+    Ok(entries)
+}
+
+fn mean(c: Color) -> f64 {
+    (c.x + c.y + c.z) / 3.0
+}
+
+impl MtlEntry {
+    /// glint's material for this entry, named `name` (the mapping in the
+    /// module docs).
+    pub fn to_material(&self, name: String) -> Material {
+        let illum = self.illum.unwrap_or(2);
+        let unit = |x: f64| x.clamp(0.0, 1.0);
+        let ks = self.ks.map_or(0.0, |c| unit(mean(c)));
+        let reflects = matches!(illum, 3..=9);
+        let refracts = matches!(illum, 6 | 7);
+        let opacity = unit(self.d.unwrap_or(1.0));
+        let mut transparency = 1.0 - opacity;
+        if refracts && opacity == 1.0 {
+            transparency = self.tf.map_or(1.0, |c| unit(mean(c)));
+        }
+        let reflectivity = if reflects { ks } else { 0.0 };
+        // What is reflected is not also transmitted.
+        transparency = transparency.min(1.0 - reflectivity);
+        Material {
+            name,
+            color: self.kd.map_or(Material::default().color, |c| {
+                c.clamp(DVec3::ZERO, DVec3::ONE)
+            }),
+            ka: if illum == 0 { 0.0 } else { 1.0 },
+            kd: 1.0,
+            ks: if matches!(illum, 0 | 1 | 10) { 0.0 } else { ks },
+            shininess: self.ns.map_or(Material::default().shininess, |n| {
+                n.clamp(0.0, *crate::limits::SHININESS_RANGE.end())
+            }),
+            reflectivity,
+            transparency,
+            ior: if refracts {
+                self.ni.map_or(Material::default().ior, |n| {
+                    n.clamp(
+                        *crate::limits::IOR_RANGE.start(),
+                        *crate::limits::IOR_RANGE.end(),
+                    )
+                })
+            } else {
+                1.0
+            },
+        }
+    }
+}
+
+/// Keywords not rendered, with the number of materials that use each.
+pub(super) fn not_rendered(entries: &[MtlEntry]) -> BTreeMap<String, usize> {
+    let mut out = BTreeMap::new();
+    for e in entries {
+        for k in &e.not_rendered {
+            *out.entry(k.clone()).or_default() += 1;
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const LIBRARY: &str = "\
+# Cornell box style
+newmtl red
+Kd 0.63 0.065 0.05
+Ka 0.63 0.065 0.05
+illum 1
+
+newmtl mirror
+Kd 0 0 0
+Ks 0.9 0.9 0.9
+Ns 1000
+illum 3
+
+newmtl glass
+Kd 0.05 0.05 0.05
+Ks 0.1 0.1 0.1
+Ni 1.5
+d 0.1
+illum 7
+map_Kd glass.png
+Ke 0 0 0
+
+newmtl tinted
+Kd 0.5
+Tr 0.25
+map_Kd tint.png
+bump tint_n.png
+";
+
+    #[test]
+    fn the_mapping_of_the_module_docs() {
+        let entries = parse(LIBRARY.as_bytes()).unwrap();
+        let m: Vec<Material> = entries
+            .iter()
+            .map(|e| e.to_material(e.name.clone()))
+            .collect();
+        assert_eq!(m[0].color, DVec3::new(0.63, 0.065, 0.05));
+        assert_eq!(
+            (m[0].ks, m[0].reflectivity, m[0].transparency),
+            (0.0, 0.0, 0.0)
+        );
+        assert_eq!(m[1].reflectivity, 0.9);
+        assert_eq!(m[1].shininess, 1000.0);
+        assert_eq!(m[1].transparency, 0.0);
+        assert!((m[2].transparency - 0.9).abs() < 1e-12);
+        assert_eq!(m[2].ior, 1.5);
+        assert!((m[2].reflectivity - 0.1).abs() < 1e-12);
+        assert_eq!(m[3].color, DVec3::splat(0.5));
+        assert_eq!(m[3].transparency, 0.25);
+        assert_eq!(m[3].ior, 1.0, "not a refracting illum model");
+        for material in &m {
+            material.validate().unwrap();
+        }
+        let listed = not_rendered(&entries);
+        assert_eq!(listed["map_Kd"], 2);
+        assert_eq!(listed["bump"], 1);
+        assert!(!listed.contains_key("Ke") && !listed.contains_key("Ka"));
+    }
+
+    #[test]
+    fn refracting_glass_with_opacity_one_uses_its_filter() {
+        let entries = parse(b"newmtl g\nKs 0.05 0.05 0.05\nNi 1.33\nillum 7\n").unwrap();
+        let m = entries[0].to_material("g".into());
+        assert_eq!((m.transparency, m.ior), (0.95, 1.33));
+        let entries = parse(b"newmtl g\nTf 0.5 0.5 0.5\nillum 6\n").unwrap();
+        assert_eq!(entries[0].to_material("g".into()).transparency, 0.5);
+    }
+
+    #[test]
+    fn refusals_name_the_line() {
+        let e = parse(b"newmtl a\nKd 1 x 0\n").unwrap_err();
+        assert_eq!(e.line, 2);
+        let e = parse(b"Kd 1 1 1\n").unwrap_err();
+        assert!(e.message.contains("before the first `newmtl`"), "{e}");
+        let e = parse(b"newmtl a\nillum 2.5\n").unwrap_err();
+        assert_eq!(e.line, 2);
+    }
+}

@@ -1,0 +1,129 @@
+//! An `.obj` opened directly: glint writes the TOML scene around it (the
+//! model with its own MTL materials, a camera that frames it, one light over
+//! the camera's shoulder) and loads that. The written text is the scene's
+//! source, so an export records it and re-renders the same picture.
+
+use std::path::Path;
+
+use crate::camera::CameraSpec;
+use crate::math::DVec3;
+
+use super::mesh::MeshSource;
+use super::model::{Scene, SceneError};
+use super::toml_format;
+
+/// Vertical field of view of the framing camera, degrees.
+const FOV: f64 = 40.0;
+
+/// The TOML scene around the OBJ file `path`, with `camera` and the light
+/// at `light`.
+fn wrapper_text(path: &Path, camera: &CameraSpec, light: DVec3) -> String {
+    let file = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let quoted = toml::Value::String(file.clone()).to_string();
+    let v = |p: DVec3| format!("[{}, {}, {}]", p.x, p.y, p.z);
+    format!(
+        "# The scene glint writes around {file} when it is opened directly: the\n\
+         # model in its own materials, a camera that frames it, one light over\n\
+         # the camera's shoulder. Save it as .toml to change any of it.\n\
+         \n\
+         [camera]\n\
+         eye = {}\n\
+         lookat = {}\n\
+         up = {}\n\
+         fov = {}\n\
+         \n\
+         [image]\n\
+         width = 640\n\
+         height = 480\n\
+         samples = 16\n\
+         max_depth = 5\n\
+         background = [0.05, 0.05, 0.05]\n\
+         ambient = [0.1, 0.1, 0.1]\n\
+         \n\
+         [[lights]]\n\
+         position = {}\n\
+         color = [1, 1, 1]\n\
+         \n\
+         [[objects]]\n\
+         kind = \"mesh\"\n\
+         path = {quoted}\n",
+        v(camera.eye),
+        v(camera.lookat),
+        v(camera.up),
+        camera.fov,
+        v(light),
+    )
+}
+
+/// Loads the OBJ file `path` as a scene of its own.
+pub(super) fn load(path: &Path, files: &dyn MeshSource) -> Result<Scene, SceneError> {
+    // Parse once with a provisional camera, then frame the bounds.
+    let provisional = CameraSpec {
+        eye: DVec3::Z,
+        lookat: DVec3::ZERO,
+        up: DVec3::Y,
+        fov: FOV,
+    };
+    let text = wrapper_text(path, &provisional, DVec3::Y);
+    let mut scene = toml_format::parse(&text, path, files)?;
+    let bounds = scene.geometry_bounds();
+    let center = bounds.center();
+    let radius = (0.5 * bounds.extent().length()).max(f64::MIN_POSITIVE);
+    // Seen from the front (+z, the usual forward of OBJ exports), a little
+    // from above, far enough that the bounding sphere fits the view.
+    let direction = DVec3::new(0.0, 0.25, 1.0).normalize();
+    let distance = radius / (0.5 * FOV.to_radians()).sin() * 1.05;
+    let camera = CameraSpec {
+        eye: center + direction * distance,
+        lookat: center,
+        up: DVec3::Y,
+        fov: FOV,
+    };
+    let light = center + DVec3::new(-0.5, 1.0, 0.8).normalize() * (distance * 1.5);
+    let text = wrapper_text(path, &camera, light);
+    scene.camera = camera;
+    if let Some(l) = scene.lights.first_mut() {
+        l.position = light;
+    }
+    scene.source_text = std::sync::Arc::from(text.as_str());
+    Ok(scene)
+}
+
+/// Parses `text`, the TOML an OBJ file `path` was opened with (an
+/// export's record), as that scene again.
+pub(super) fn reload(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, SceneError> {
+    toml_format::parse(text, path, files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    struct Files;
+    impl MeshSource for Files {
+        fn read(&self, path: &Path) -> std::io::Result<Vec<u8>> {
+            match path.file_name().and_then(|n| n.to_str()) {
+                Some("two.obj") => Ok(b"mtllib two.mtl\nv 10 0 0\nv 12 0 0\nv 12 2 0\nv 10 2 0\nusemtl red\nf 1 2 3\nusemtl blue\nf 1 3 4\n".to_vec()),
+                Some("two.mtl") => Ok(b"newmtl red\nKd 1 0 0\nnewmtl blue\nKd 0 0 1\n".to_vec()),
+                _ => Err(std::io::ErrorKind::NotFound.into()),
+            }
+        }
+    }
+
+    #[test]
+    fn an_obj_is_framed_and_its_text_loads_it_again() {
+        let path = Path::new("models/two.obj");
+        let scene = load(path, &Files).unwrap();
+        assert_eq!(scene.camera.lookat, DVec3::new(11.0, 1.0, 0.0));
+        let names: Vec<&str> = scene.materials.iter().map(|m| m.name.as_str()).collect();
+        assert_eq!(names, ["red", "blue"]);
+        assert_eq!(*scene.shape_materials, [0, 1]);
+        let again = reload(&scene.source_text, path, &Files).unwrap();
+        assert_eq!(again.camera, scene.camera);
+        assert_eq!(again.lights, scene.lights);
+        assert_eq!(again.materials, scene.materials);
+    }
+}
