@@ -20,8 +20,8 @@ pub use model::{ImageSettings, Location, Scene, SceneError};
 pub use obj::SkippedElements;
 pub use polygon::DroppedPolygons;
 
-/// Loads a `.toml` or `.nff` scene file, or an `.obj` model as a scene of
-/// its own ([`obj_scene`]).
+/// Loads a `.toml` or `.nff` scene file, or an `.obj` model in a scene
+/// glint writes around it.
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
     if extension(path).as_deref() == Some("obj") {
         return obj_scene::load(path, &mesh::FileSystem);

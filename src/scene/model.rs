@@ -186,6 +186,12 @@ impl Scene {
         if !parts.is_empty() {
             notes.push(format!("OBJ elements skipped: {}", parts.join(", ")));
         }
+        if skipped.faces_with_missing_normals > 0 {
+            notes.push(format!(
+                "{} OBJ faces refer to normals the file does not have; they are shaded without them",
+                skipped.faces_with_missing_normals
+            ));
+        }
         if skipped.faces_with_repeated_vertices > 0 {
             notes.push(format!(
                 "{} OBJ faces listed a vertex more than once; the repeats were removed",
@@ -338,6 +344,10 @@ pub enum SceneError {
         mesh: PathBuf,
         message: String,
     },
+    /// A model opened directly ([`super::load`] of an `.obj`) that cannot
+    /// be read: the file and, in `message`, the line.
+    #[error("{path}: {message}")]
+    Model { path: PathBuf, message: String },
     #[error("{path}: unknown scene format (expected a .toml, .nff or .obj file)")]
     UnknownFormat { path: PathBuf },
 }

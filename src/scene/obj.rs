@@ -54,6 +54,9 @@ pub struct SkippedElements {
     /// Faces that listed a vertex more than once: the repeats were removed
     /// before triangulation.
     pub faces_with_repeated_vertices: usize,
+    /// Faces whose normal indices point past the file's normals: shaded
+    /// without them.
+    pub faces_with_missing_normals: usize,
     /// Other statements (free-form curves and surfaces, display attributes),
     /// by keyword.
     pub statements: BTreeMap<String, usize>,
@@ -65,6 +68,7 @@ impl SkippedElements {
         self.points += other.points;
         self.short_faces += other.short_faces;
         self.faces_with_repeated_vertices += other.faces_with_repeated_vertices;
+        self.faces_with_missing_normals += other.faces_with_missing_normals;
         for (k, n) in &other.statements {
             *self.statements.entry(k.clone()).or_default() += n;
         }
@@ -214,28 +218,28 @@ pub(super) fn parse(bytes: &[u8]) -> Result<ObjData, ObjError> {
             }
         }
     }
-    // Check the indices now that every vertex is known.
+    // Check the indices now that every vertex is known. A face whose
+    // normals do not exist is kept without them (exporters write `i//n`
+    // with no `vn`); a missing vertex leaves nothing to draw.
     let (positions, normals) = (data.positions.len(), data.normals.len());
     for (face, &line) in data.faces.iter().zip(&last_line_of_face) {
-        let corners = &data.corners[face.start as usize..(face.start + face.len) as usize];
-        for &(p, n) in corners {
-            if p as usize >= positions {
-                return Err(ObjError {
-                    line,
-                    message: format!(
-                        "vertex index {} is out of range (the file has {positions} vertices)",
-                        p as u64 + 1
-                    ),
-                });
-            }
-            if n != NO_NORMAL && n as usize >= normals {
-                return Err(ObjError {
-                    line,
-                    message: format!(
-                        "normal index {} is out of range (the file has {normals} normals)",
-                        n as u64 + 1
-                    ),
-                });
+        let corners = &mut data.corners[face.start as usize..(face.start + face.len) as usize];
+        if let Some(&(p, _)) = corners.iter().find(|(p, _)| *p as usize >= positions) {
+            return Err(ObjError {
+                line,
+                message: format!(
+                    "vertex index {} is out of range (the file has {positions} vertices)",
+                    p as u64 + 1
+                ),
+            });
+        }
+        if corners
+            .iter()
+            .any(|&(_, n)| n != NO_NORMAL && n as usize >= normals)
+        {
+            data.skipped.faces_with_missing_normals += 1;
+            for corner in corners.iter_mut() {
+                corner.1 = NO_NORMAL;
             }
         }
     }
@@ -341,10 +345,15 @@ mod tests {
 
     #[test]
     fn refusals_name_the_line() {
-        let cases: [(&str, usize, &str); 5] = [
+        let cases: [(&str, usize, &str); 6] = [
             ("v 0 0 0\nv 1 x 0\n", 2, "`x` is not a number"),
             ("v 0 0\n", 1, "needs three coordinates"),
             ("v 0 0 0\n\nf 1 2 3\n", 3, "vertex index 2 is out of range"),
+            (
+                "v 0 0 0\nf 1//1 2//1 1//1\n",
+                2,
+                "vertex index 2 is out of range",
+            ),
             ("v 0 0 0\nf 0 1 1\n", 2, "vertex index 0"),
             (
                 "v 0 0 0\nv 1 0 0\nf -3 1 2\n",
@@ -357,6 +366,19 @@ mod tests {
             assert_eq!(e.line, line, "{text:?}: {e}");
             assert!(e.message.contains(needle), "{text:?}: {e}");
         }
+    }
+
+    #[test]
+    fn normals_that_do_not_exist_are_dropped_and_counted() {
+        let data =
+            parse(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//2\nf 1//1 2//1 3//1\n")
+                .unwrap();
+        assert_eq!(data.skipped.faces_with_missing_normals, 1);
+        assert_eq!(
+            &data.corners[0..3],
+            &[(0, NO_NORMAL), (1, NO_NORMAL), (2, NO_NORMAL)]
+        );
+        assert_eq!(&data.corners[3..6], &[(0, 0), (1, 0), (2, 0)]);
     }
 
     #[test]

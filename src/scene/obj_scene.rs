@@ -68,7 +68,15 @@ pub(super) fn load(path: &Path, files: &dyn MeshSource) -> Result<Scene, SceneEr
         fov: FOV,
     };
     let text = wrapper_text(path, &provisional, DVec3::Y);
-    let mut scene = toml_format::parse(&text, path, files)?;
+    // The written scene is correct by construction: any error is the
+    // model's, and is told as the model's, not as a place in that text.
+    let mut scene = toml_format::parse(&text, path, files).map_err(|e| match e {
+        SceneError::Mesh { mesh, message, .. } => SceneError::Model {
+            path: mesh,
+            message,
+        },
+        other => other,
+    })?;
     let bounds = scene.geometry_bounds();
     let center = bounds.center();
     let radius = (0.5 * bounds.extent().length()).max(f64::MIN_POSITIVE);
