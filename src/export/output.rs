@@ -86,8 +86,56 @@ pub fn check_output(path: &Path, input: Option<&Path>) -> Result<OutputTarget, E
                 path: path.to_owned(),
             });
         }
+        // The folder must exist and take a new file now, not after a render
+        // of minutes: try the temporary file the write will use.
+        temporary_in(&folder_of(file)).map_err(|source| ExportError::Write {
+            path: path.to_owned(),
+            source,
+        })?;
     }
     Ok(target)
+}
+
+/// The folder a file named `file` goes in (`.` for a bare name).
+fn folder_of(file: &Path) -> PathBuf {
+    match file.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_owned(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// A new hidden temporary file in `dir` with `permissions`, removed when
+/// dropped. Errors keep their kind but not the temporary name: messages
+/// name the user's path.
+fn temporary_with(
+    dir: &Path,
+    permissions: std::fs::Permissions,
+) -> std::io::Result<tempfile::NamedTempFile> {
+    // The folder first, for the system's own words ("No such file or
+    // directory", "Not a directory").
+    let folder = std::fs::metadata(dir)?;
+    if !folder.is_dir() {
+        return Err(std::io::Error::from_raw_os_error(20)); // ENOTDIR
+    }
+    tempfile::Builder::new()
+        .prefix(".glint-")
+        .suffix(".png.tmp")
+        .permissions(permissions)
+        .tempfile_in(dir)
+        .map_err(|e| without_path(&e))
+}
+
+/// `e` without the temporary file's name tempfile adds (its kind only).
+fn without_path(e: &std::io::Error) -> std::io::Error {
+    e.raw_os_error().map_or_else(
+        || std::io::Error::from(e.kind()),
+        std::io::Error::from_raw_os_error,
+    )
+}
+
+fn temporary_in(dir: &Path) -> std::io::Result<tempfile::NamedTempFile> {
+    use std::os::unix::fs::PermissionsExt;
+    temporary_with(dir, std::fs::Permissions::from_mode(0o600))
 }
 
 /// The file a new output named `path` creates: `path` itself, or the
@@ -145,22 +193,14 @@ pub fn save_rgb_png(
             w.flush().map_err(write_error)
         }
         OutputTarget::File(target) => {
-            let dir = match target.parent() {
-                Some(d) if !d.as_os_str().is_empty() => d.to_owned(),
-                _ => PathBuf::from("."),
-            };
+            let dir = folder_of(&target);
             // A replaced file keeps its permissions; a new one gets the
             // usual 0666 less the umask (tempfile's own default is 0600).
             use std::os::unix::fs::PermissionsExt;
             let permissions = std::fs::metadata(&target)
                 .map(|m| m.permissions())
                 .unwrap_or_else(|_| std::fs::Permissions::from_mode(0o666));
-            let tmp = tempfile::Builder::new()
-                .prefix(".glint-")
-                .suffix(".png.tmp")
-                .permissions(permissions)
-                .tempfile_in(&dir)
-                .map_err(write_error)?;
+            let tmp = temporary_with(&dir, permissions).map_err(write_error)?;
             {
                 let mut w = std::io::BufWriter::new(tmp.as_file());
                 write_png(&mut w, path, width, height, rgb, record)?;
@@ -168,7 +208,8 @@ pub fn save_rgb_png(
                 w.flush().map_err(write_error)?;
             }
             // Dropped (and deleted) on any error above.
-            tmp.persist(&target).map_err(|e| write_error(e.error))?;
+            tmp.persist(&target)
+                .map_err(|e| write_error(without_path(&e.error)))?;
             Ok(())
         }
     }
