@@ -3,9 +3,11 @@
 
 use std::path::Path;
 
+use super::model::Scene;
 use super::mtl::{self, MtlEntry};
 use super::obj::{self, NO_NORMAL, SkippedElements};
 use super::polygon::{DroppedPolygons, triangulate};
+use crate::material::Material;
 use crate::math::DVec3;
 
 /// Where mesh files come from: the file system, or memory for scenes
@@ -184,6 +186,69 @@ pub(super) fn read_libraries(
         }
     }
     entries
+}
+
+/// The scene's material index for each of `mesh`'s `usemtl` slots: its
+/// libraries' materials, added to the scene once each (named after the
+/// MTL, made unique), and the default material for faces with none or
+/// with a name no library defines.
+pub(super) fn mesh_materials(
+    scene: &mut Scene,
+    mesh: &LoadedMesh,
+    mesh_path: &Path,
+    files: &dyn MeshSource,
+) -> Vec<u32> {
+    let entries = read_libraries(&mesh.libraries, mesh_path, files, &mut scene.load_notes);
+    for (k, n) in mtl::not_rendered(&entries) {
+        *scene.not_rendered.entry(k).or_default() += n;
+    }
+    let add = |scene: &mut Scene, material: Material| -> u32 {
+        let mut name = material.name.clone();
+        let mut k = 2;
+        while scene.materials.iter().any(|m| m.name == name) {
+            name = format!("{} ({k})", material.name);
+            k += 1;
+        }
+        scene.materials.push(Material { name, ..material });
+        scene.materials.len() as u32 - 1
+    };
+    let mut default = None;
+    let mut slots = Vec::with_capacity(mesh.material_names.len());
+    let used: Vec<bool> = {
+        let mut used = vec![false; mesh.material_names.len()];
+        for &m in &mesh.triangle_materials {
+            used[m as usize] = true;
+        }
+        used
+    };
+    for (slot, name) in mesh.material_names.iter().enumerate() {
+        let entry = (slot > 0)
+            .then(|| entries.iter().find(|e| e.name == *name))
+            .flatten();
+        let index = match entry {
+            Some(e) if used[slot] => add(scene, e.to_material(e.name.clone())),
+            _ if !used[slot] => u32::MAX,
+            _ => {
+                if slot > 0 {
+                    scene.load_notes.push(format!(
+                        "{}: no material library defines `{name}`; its faces use the default material",
+                        mesh_path.display()
+                    ));
+                }
+                *default.get_or_insert_with(|| {
+                    add(
+                        scene,
+                        Material {
+                            name: "default".into(),
+                            ..Material::default()
+                        },
+                    )
+                })
+            }
+        };
+        slots.push(index);
+    }
+    slots
 }
 
 /// Area-weighted vertex normals for a triangle soup, vertices matched by
