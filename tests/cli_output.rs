@@ -176,6 +176,54 @@ fn other_extensions_and_the_input_scene_are_refused() {
     assert_eq!(std::fs::read(&first).unwrap(), before, "left untouched");
 }
 
+/// A folder that is not there is found before the render, and the message
+/// names the user's path, not the temporary file the write goes through;
+/// nothing is left behind.
+#[test]
+fn a_missing_output_folder_is_refused_before_rendering() {
+    let tmp = common::temp_dir();
+    let out = tmp.path().join("no/such/folder/a.png");
+    // With --trace-pixel the tree is printed only after the checks: no
+    // tree on standard output shows that nothing was traced.
+    let mut args = small(&out);
+    args.extend(["--trace-pixel".into(), "1,1".into()]);
+    let o = run(&args);
+    assert!(!o.status.success());
+    let text = stderr(&o);
+    assert!(
+        text.contains(&format!("cannot write {}", out.display())),
+        "{text}"
+    );
+    assert!(
+        !text.contains(".glint-") && !text.contains("wrote"),
+        "{text}"
+    );
+    assert!(o.stdout.is_empty(), "traced before refusing");
+    let left: Vec<_> = std::fs::read_dir(tmp.path()).unwrap().collect();
+    assert!(left.is_empty(), "{left:?}");
+}
+
+/// A file that describes nothing to see says so instead of rendering a
+/// blank picture without a word.
+#[test]
+fn an_empty_scene_is_said_to_be_empty() {
+    let tmp = common::temp_dir();
+    let nff = tmp.path().join("empty.nff");
+    std::fs::write(
+        &nff,
+        "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 1\nresolution 8 8\n",
+    )
+    .unwrap();
+    let out = tmp.path().join("empty.png");
+    let o = glint(&["render", nff.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stderr(&o);
+    assert!(
+        text.contains("no objects") && text.contains("no lights"),
+        "{text}"
+    );
+}
+
 #[test]
 fn success_is_one_line_on_stderr_unless_quiet() {
     let tmp = common::temp_dir();

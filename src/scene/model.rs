@@ -139,6 +139,12 @@ impl Scene {
     /// for the command line's notes and the viewer's messages.
     pub fn notes(&self) -> Vec<String> {
         let mut notes = Vec::new();
+        if self.shapes.is_empty() {
+            notes.push("the scene has no objects: the picture is its background".into());
+        }
+        if self.lights.is_empty() {
+            notes.push("the scene has no lights: surfaces get the ambient term only".into());
+        }
         if self.dropped_triangles > 0 {
             notes.push(format!(
                 "{} degenerate triangles were skipped",

@@ -173,7 +173,11 @@ pub fn inspect_controls_ui(
         ui.checkbox(&mut overlay, "Octree overlay");
         let mut depth = inspect.overlay_depth.unwrap_or(3);
         ui.label("to depth");
-        ui.add(egui::DragValue::new(&mut depth).range(0..=crate::limits::MAX_OCTREE_DEPTH));
+        ui.add(
+            egui::DragValue::new(&mut depth)
+                .update_while_editing(false)
+                .range(0..=crate::limits::MAX_OCTREE_DEPTH),
+        );
         inspect.overlay_depth = overlay.then_some(depth);
     });
     ui.checkbox(&mut inspect.inspect_mode, "Inspect: click picks a pixel");

@@ -70,7 +70,12 @@ fn vec3_ui(ui: &mut egui::Ui, label: &str, v: &mut DVec3, speed: f64) -> bool {
         ui.label(label);
         for c in [&mut v.x, &mut v.y, &mut v.z] {
             changed |= ui
-                .add(DragValue::new(c).speed(speed).max_decimals(4))
+                .add(
+                    DragValue::new(c)
+                        .update_while_editing(false)
+                        .speed(speed)
+                        .max_decimals(4),
+                )
                 .changed();
         }
     });
@@ -176,7 +181,9 @@ fn render_settings_ui(edit: &mut EditState, ui: &mut egui::Ui) {
         ui.label("Max depth");
         ui.add_enabled(
             !spd,
-            DragValue::new(&mut edit.settings.max_depth).range(1..=64),
+            DragValue::new(&mut edit.settings.max_depth)
+                .update_while_editing(false)
+                .range(1..=crate::limits::MAX_RAY_DEPTH),
         );
     });
     ui.horizontal(|ui| {
@@ -204,7 +211,7 @@ fn render_settings_ui(edit: &mut EditState, ui: &mut egui::Ui) {
     ui.horizontal(|ui| {
             ui.label("Frame budget while moving");
             ui.add(
-                DragValue::new(&mut edit.frame_budget_ms)
+                DragValue::new(&mut edit.frame_budget_ms).update_while_editing(false)
                     .range(5.0..=1000.0)
                     .speed(1.0)
                     .suffix(" ms"),
@@ -216,9 +223,17 @@ fn render_settings_ui(edit: &mut EditState, ui: &mut egui::Ui) {
         });
     ui.horizontal(|ui| {
         ui.label("Image size");
-        ui.add(DragValue::new(&mut edit.settings.width).range(1..=8192));
+        ui.add(
+            DragValue::new(&mut edit.settings.width)
+                .update_while_editing(false)
+                .range(1..=8192),
+        );
         ui.label("x");
-        ui.add(DragValue::new(&mut edit.settings.height).range(1..=8192));
+        ui.add(
+            DragValue::new(&mut edit.settings.height)
+                .update_while_editing(false)
+                .range(1..=8192),
+        );
     });
     ui.horizontal_wrapped(|ui| {
         ui.label("View");
@@ -239,6 +254,7 @@ fn camera_ui(edit: &mut EditState, speed: f64, ui: &mut egui::Ui) -> Vec<Command
         ui.label("fov");
         ui.add(
             DragValue::new(&mut c.fov)
+                .update_while_editing(false)
                 .range(0.01..=179.0)
                 .speed(0.1)
                 .suffix("°"),
@@ -293,7 +309,12 @@ fn materials_ui(edit: &mut EditState, ui: &mut egui::Ui) {
                         ] {
                             ui.label(label);
                             changed |= ui
-                                .add(DragValue::new(value).range(range).speed(step))
+                                .add(
+                                    DragValue::new(value)
+                                        .update_while_editing(false)
+                                        .range(range)
+                                        .speed(step),
+                                )
                                 .changed();
                             ui.end_row();
                         }

@@ -41,7 +41,7 @@ pub struct BenchArgs {
     #[command(flatten)]
     pub octree_params: OctreeArgs,
     /// Render threads (default: one per core; at most 8 per core).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, hide_default_value = true)]
     pub threads: usize,
     /// Output format.
     #[arg(long, value_enum, default_value = "markdown")]

@@ -57,7 +57,7 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub octree_params: OctreeArgs,
     /// Render threads (default: one per core; at most 8 per core).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, hide_default_value = true)]
     pub threads: usize,
     /// What the image shows: shaded, normals, depth, cost (intersection
     /// tests per pixel), cost-steps (traversal steps per pixel) or aa-need

@@ -35,7 +35,7 @@ pub struct StudyArgs {
     #[arg(long, default_value_t = 3, value_parser = parse_positive)]
     pub repeat: u32,
     /// Render threads (default: one per core; at most 8 per core).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, hide_default_value = true)]
     pub threads: usize,
 }
 

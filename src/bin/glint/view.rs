@@ -34,7 +34,7 @@ pub struct ViewArgs {
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
     /// Render threads (default: one per core; at most 8 per core).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, hide_default_value = true)]
     pub threads: usize,
     /// Window size as WIDTHxHEIGHT in points.
     #[arg(long, default_value = "1400x860", value_parser = parse_size)]
@@ -115,6 +115,17 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         }),
         compare_difference: args.compare_difference,
     };
+    // Without a display winit fails with its own source path in the
+    // message: say what is missing and what works headless instead.
+    let no_display = ["DISPLAY", "WAYLAND_DISPLAY", "WAYLAND_SOCKET"]
+        .iter()
+        .all(|v| std::env::var_os(v).is_none_or(|x| x.is_empty()));
+    anyhow::ensure!(
+        !no_display,
+        "no display found (DISPLAY and WAYLAND_DISPLAY are unset): the viewer needs a window. \
+         Render headless with `glint render SCENE -o out.png`, or run the viewer under a \
+         virtual display: `xvfb-run -a glint view SCENE --screenshot out.png`"
+    );
     let native = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_inner_size([w, h])
