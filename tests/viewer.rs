@@ -508,3 +508,29 @@ fn a_deep_ray_tree_leaves_the_panels_and_the_image_apart() {
     assert!(after.max.x <= 1200.0 - 330.0, "{after:?}");
     assert!(after.min.x >= 330.0, "{after:?}");
 }
+
+/// A number typed into a field is taken on Enter, not key by key: typing
+/// 200 into the width does not first render widths 2 and 20.
+#[test]
+fn a_typed_number_is_taken_on_enter() {
+    let mut h = harness(app_for("scenes/sphere.toml", 77, 48));
+    let generation = h.state().worker().generation();
+    h.get_by_value("77").focus();
+    h.run_steps(1);
+    // Focused, the field is a text edit with the whole number selected.
+    for key in ["2", "0", "0"] {
+        h.get_by(|n| n.is_focused()).type_text(key);
+        h.run_steps(1);
+    }
+    h.run_steps(2);
+    assert_eq!(h.state().settings().width, 77, "taken while typing");
+    assert_eq!(
+        h.state().worker().generation(),
+        generation,
+        "restarted while typing"
+    );
+    h.key_press(egui::Key::Enter);
+    h.run_steps(2);
+    assert_eq!(h.state().settings().width, 200);
+    assert!(h.state().worker().generation() > generation);
+}
