@@ -15,6 +15,14 @@ pub const MAX_IMAGE_SIDE: u32 = 1 << 15;
 pub const MAX_PIXELS: u64 = 1 << 28;
 pub const MAX_RAY_DEPTH: u32 = 64;
 
+/// Largest image side the viewer renders: it keeps several frames of this
+/// size (display, passes, compare) in memory at once and draws them as
+/// textures; larger images are for `glint render`.
+pub const MAX_VIEWER_SIDE: u32 = 8192;
+
+/// Smallest viewer window, in points: below it the panels cannot show.
+pub const MIN_WINDOW: (u32, u32) = (480, 320);
+
 /// Largest side of the regular sample grid in a pixel (16x16 = 256 rays):
 /// scene files and the command line offer 1 and 16 samples; the study also
 /// measures 4, 64 and 256.

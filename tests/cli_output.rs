@@ -298,3 +298,46 @@ fn limits_are_stated_when_refused() {
     (settings.width, settings.height) = (1024, 1024);
     assert!(glint::render::memory::check_memory_against(&settings, 0, 1 << 30).is_ok());
 }
+
+/// `glint view` refuses what it cannot show, before opening a window, as
+/// `glint render` refuses what it cannot render.
+#[test]
+fn the_viewer_refuses_sizes_windows_and_pixels_it_cannot_show() {
+    let s = scene();
+    for (args, needle) in [
+        (vec!["--size", "100000x100"], "outside the limits"),
+        (vec!["--size", "9000x100"], "at most 8192 pixels a side"),
+        (
+            vec!["--window", "10x10"],
+            "smaller than the viewer can show",
+        ),
+        (
+            vec!["--size", "64x48", "--inspect", "70,1"],
+            "outside the 64x48 image",
+        ),
+    ] {
+        let mut all = vec!["view", s.as_str()];
+        all.extend(args.iter().copied());
+        let o = glint(&all);
+        assert!(!o.status.success(), "{args:?} accepted");
+        assert!(stderr(&o).contains(needle), "{args:?}: {}", stderr(&o));
+    }
+}
+
+/// The closing line gives the written file's size, legend strip included.
+#[test]
+fn the_reported_size_is_the_files() {
+    let tmp = common::temp_dir();
+    let out = tmp.path().join("cost.png");
+    let mut args = small(&out);
+    args.extend(["--view".into(), "cost".into()]);
+    let o = run(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (w, h) = image::image_dimensions(&out).unwrap();
+    assert!(h > 12, "the legend is under the image");
+    assert!(
+        stderr(&o).contains(&format!("({w}x{h}, ")),
+        "{}",
+        stderr(&o)
+    );
+}

@@ -226,13 +226,13 @@ fn render_settings_ui(edit: &mut EditState, ui: &mut egui::Ui) {
         ui.add(
             DragValue::new(&mut edit.settings.width)
                 .update_while_editing(false)
-                .range(1..=8192),
+                .range(1..=crate::limits::MAX_VIEWER_SIDE),
         );
         ui.label("x");
         ui.add(
             DragValue::new(&mut edit.settings.height)
                 .update_while_editing(false)
-                .range(1..=8192),
+                .range(1..=crate::limits::MAX_VIEWER_SIDE),
         );
     });
     ui.horizontal_wrapped(|ui| {

@@ -384,10 +384,17 @@ fn report(
     let (scene, settings, octree) = (&job.scene, &job.settings, &job.octree);
     let (frame, counts) = (&rendered.frame, &rendered.counts);
     if !args.quiet {
+        // The file's own size: cost views add their legend under the image.
+        let (mut width, mut height) = (frame.width, frame.height);
         let written = match glint::export::OutputTarget::resolve(output)? {
-            glint::export::OutputTarget::File(p) => std::fs::metadata(&p)
-                .map(|m| format!(", {} KiB", m.len().div_ceil(1024)))
-                .unwrap_or_default(),
+            glint::export::OutputTarget::File(p) => {
+                if let Ok((w, h)) = image::image_dimensions(&p) {
+                    (width, height) = (w, h);
+                }
+                std::fs::metadata(&p)
+                    .map(|m| format!(", {} KiB", m.len().div_ceil(1024)))
+                    .unwrap_or_default()
+            }
             _ => String::new(),
         };
         eprintln!(
@@ -397,8 +404,8 @@ fn report(
             } else {
                 output.display().to_string()
             },
-            frame.width,
-            frame.height,
+            width,
+            height,
             job.load_s + job.build_s + render_s,
             job.load_s,
             job.build_s,

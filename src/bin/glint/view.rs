@@ -91,7 +91,14 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         None => SceneSource::BuiltIn,
     };
     // Load once up front so a bad scene is a clear error, not a blank window.
-    source.load()?;
+    let scene = source.load()?;
+    let (min_w, min_h) = glint::limits::MIN_WINDOW;
+    anyhow::ensure!(
+        args.window.0 >= min_w && args.window.1 >= min_h,
+        "--window {}x{} is smaller than the viewer can show ({min_w}x{min_h} at least)",
+        args.window.0,
+        args.window.1
+    );
     let (w, h) = (args.window.0 as f32, args.window.1 as f32);
     let mut overrides = Overrides {
         width: args.size.map(|(w, _)| w),
@@ -102,6 +109,27 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         ..Overrides::default()
     };
     args.rules.add_to(&mut overrides);
+    // The size the window will render, checked as the CLI checks it, and
+    // against the viewer's own limit (it would clamp without a word).
+    let mut settings = scene.render_settings();
+    let mut params = scene.octree_params;
+    overrides.apply(&mut settings, &mut params);
+    settings.check()?;
+    let side = glint::limits::MAX_VIEWER_SIDE;
+    anyhow::ensure!(
+        settings.width <= side && settings.height <= side,
+        "the viewer renders at most {side} pixels a side, not {}x{}; use glint render for larger images",
+        settings.width,
+        settings.height
+    );
+    if let Some((x, y)) = args.inspect {
+        anyhow::ensure!(
+            x < settings.width && y < settings.height,
+            "--inspect {x},{y} is outside the {}x{} image",
+            settings.width,
+            settings.height
+        );
+    }
     let options = ViewerOptions {
         screenshot: args.screenshot.clone(),
         frames: args.frames,
