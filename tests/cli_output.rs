@@ -301,6 +301,7 @@ fn limits_are_stated_when_refused() {
 
 /// `glint view` refuses what it cannot show, before opening a window, as
 /// `glint render` refuses what it cannot render.
+#[cfg(feature = "gui")]
 #[test]
 fn the_viewer_refuses_sizes_windows_and_pixels_it_cannot_show() {
     let s = scene();
