@@ -129,26 +129,39 @@ impl Cone {
             return false;
         }
         let r = self.base_radius.max(self.apex_radius);
-        // The squared distance from the box to a point of the axis is
-        // convex along the segment: a ternary search finds its minimum.
+        // A relative margin keeps the test conservative under rounding.
+        let reach2 = r * r * (1.0 + 1e-9) + 1e-18 * self.height * self.height;
+        // The distance from the box to a point of the axis is convex along
+        // the segment: a ternary search finds its minimum. It stops early
+        // once a point is near enough, or once even the nearest point the
+        // interval left could hold is too far: the distance changes at
+        // most `height` per unit of the parameter.
         let distance2 = |s: f64| {
             let p = self.base + s * (self.apex - self.base);
             p.distance_squared(p.clamp(b.min, b.max))
         };
+        if distance2(0.0) <= reach2 || distance2(1.0) <= reach2 {
+            return true;
+        }
+        let reach = reach2.sqrt();
         let (mut lo, mut hi) = (0.0f64, 1.0f64);
         for _ in 0..64 {
             let (m1, m2) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
-            if distance2(m1) <= distance2(m2) {
+            let (d1, d2) = (distance2(m1), distance2(m2));
+            if d1.min(d2) <= reach2 {
+                return true;
+            }
+            if d1 <= d2 {
                 hi = m2;
             } else {
                 lo = m1;
             }
+            // Every point of [lo, hi] lies within (hi - lo) height of m1 or m2.
+            if d1.min(d2).sqrt() - (hi - lo) * self.height > reach {
+                return false;
+            }
         }
-        let nearest = distance2(0.5 * (lo + hi))
-            .min(distance2(0.0))
-            .min(distance2(1.0));
-        // A relative margin keeps the test conservative under rounding.
-        nearest <= r * r * (1.0 + 1e-9) + 1e-18 * self.height * self.height
+        distance2(0.5 * (lo + hi)) <= reach2
     }
 
     pub fn bounds(&self) -> Aabb {
@@ -209,5 +222,55 @@ mod tests {
             DVec3::new(0.9, 0.9, 1.0),
         );
         assert!(c.overlaps_box(&touching), "a box reaching the surface");
+    }
+
+    #[test]
+    fn the_early_exits_give_the_dense_answer() {
+        // The axis sampled densely is the reference: the search may answer
+        // "overlaps" only within its margin of the reach, and must never
+        // miss a box within it.
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0
+        };
+        for _ in 0..2000 {
+            let base = DVec3::new(next(), next(), next());
+            let apex = DVec3::new(next(), next(), next());
+            let (rb, ra) = (next().abs() * 0.2, next().abs() * 0.2);
+            let Some(c) = Cone::new(base, rb, apex, ra) else {
+                continue;
+            };
+            let (p, q) = (
+                DVec3::new(next(), next(), next()),
+                DVec3::new(next(), next(), next()),
+            );
+            let b = Aabb::new(p.min(q), p.min(q) + (p - q).abs() * 0.25);
+            let nearest = (0..=20_000)
+                .map(|i| {
+                    let x = base + (i as f64 / 20_000.0) * (apex - base);
+                    x.distance(x.clamp(b.min, b.max))
+                })
+                .fold(f64::INFINITY, f64::min);
+            let r = rb.max(ra);
+            // Sampling finds the minimum to within a step's length.
+            let step = (apex - base).length() / 20_000.0;
+            if !c.bounds().overlaps(&b) {
+                // The exact bounds answer first; the search is for the rest.
+                assert!(!c.overlaps_box(&b));
+            } else if nearest <= r {
+                assert!(
+                    c.overlaps_box(&b),
+                    "missed a box {nearest} from the axis, r {r}"
+                );
+            } else if nearest - step > r * (1.0 + 1e-6) {
+                assert!(
+                    !c.overlaps_box(&b),
+                    "took a box {nearest} from the axis, r {r}"
+                );
+            }
+        }
     }
 }
