@@ -21,7 +21,7 @@ use std::path::Path;
 
 pub use error::ExportError;
 pub use output::{OutputTarget, check_output, save_rgb_png};
-pub use png_file::read_record;
+pub use png_file::{read_record, read_record_bytes};
 pub use record::{
     KEY_SCENE, KEY_SCENE_PATH, KEY_SCENE_SHA256, KEY_SETTINGS, KEY_VERSION, MAX_SCENE_TEXT,
     RecordedCamera, RecordedSettings, RenderRecord, SCENE_CHUNK, SceneEdits, sha256_hex,
@@ -42,6 +42,20 @@ pub fn save_png(
 ) -> Result<(), ExportError> {
     let (rgb, height) = frame.to_annotated_rgb8();
     save_rgb_png(path, frame.width, height, &rgb, record)
+}
+
+/// The PNG file `save_rgb_png` would write, as bytes in memory; `path`
+/// names it in errors.
+pub fn png_bytes(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgb: &[u8],
+    record: Option<&RenderRecord>,
+) -> Result<Vec<u8>, ExportError> {
+    let mut out = Vec::new();
+    png_file::write_png(&mut out, path, width, height, rgb, record)?;
+    Ok(out)
 }
 
 /// The octree overlay to draw into an export: its cells down to `depth`,
@@ -119,14 +133,18 @@ pub fn restore(png: &Path) -> Result<Restored, ExportError> {
 /// meshes read relative to the recorded path (or from the binary for the
 /// built-in scene).
 pub fn load_recorded_scene(record: &RenderRecord) -> Result<Scene, ExportError> {
+    load_recorded_scene_with(record, &crate::scene::FileSystem)
+}
+
+/// Like [`load_recorded_scene`], reading meshes from `files`.
+pub fn load_recorded_scene_with(
+    record: &RenderRecord,
+    files: &dyn crate::scene::MeshSource,
+) -> Result<Scene, ExportError> {
     let mut scene = if record.scene_path == crate::scene::builtin::NAME {
         crate::scene::builtin::load_text(&record.scene_text)?
     } else {
-        crate::scene::load_str(
-            &record.scene_text,
-            Path::new(&record.scene_path),
-            &crate::scene::FileSystem,
-        )?
+        crate::scene::load_str(&record.scene_text, Path::new(&record.scene_path), files)?
     };
     scene.octree_params = record.settings.octree_params;
     if let Some(edits) = &record.settings.edits {

@@ -72,14 +72,34 @@ pub fn read_record(path: &Path) -> Result<RenderRecord, ExportError> {
         path: path.to_owned(),
         source,
     })?;
+    read_record_from(std::io::BufReader::new(file), path)
+}
+
+/// Reads the record from PNG bytes in memory; `path` names them in errors.
+pub fn read_record_bytes(bytes: &[u8], path: &Path) -> Result<RenderRecord, ExportError> {
+    read_record_from(std::io::Cursor::new(bytes), path)
+}
+
+fn read_record_from<R: std::io::BufRead + std::io::Seek>(
+    mut source: R,
+    path: &Path,
+) -> Result<RenderRecord, ExportError> {
     let decode = |message: String| ExportError::Decode {
         path: path.to_owned(),
         message,
     };
+    let read_error = |source| ExportError::Read {
+        path: path.to_owned(),
+        source,
+    };
+    let scene_chunk = private_chunk(&mut source, path, SCENE_CHUNK)?;
+    source
+        .seek(std::io::SeekFrom::Start(0))
+        .map_err(read_error)?;
     // glint writes its text chunks before the image data, so reading the
     // header chunks is enough: the pixels are never decoded (a crafted
     // header cannot make this allocate).
-    let reader = png::Decoder::new(std::io::BufReader::new(file))
+    let reader = png::Decoder::new(source)
         .read_info()
         .map_err(|e| decode(e.to_string()))?;
     let info = reader.info();
@@ -107,7 +127,7 @@ pub fn read_record(path: &Path) -> Result<RenderRecord, ExportError> {
         })?;
     // Records written before the private chunk existed keep the scene in
     // an iTXt chunk.
-    let scene_text = match private_chunk(path, SCENE_CHUNK)? {
+    let scene_text = match scene_chunk {
         Some(data) => decompress(&data).map_err(|message| ExportError::Malformed {
             path: path.to_owned(),
             key: KEY_SCENE,
@@ -162,19 +182,16 @@ fn decompress(data: &[u8]) -> Result<String, String> {
 /// The data of the first chunk of type `kind` before the image data, if
 /// any. The png crate skips chunks it does not know, so glint walks the
 /// chunk list itself (PNG spec, section 5.3: length, type, data, CRC).
-fn private_chunk(path: &Path, kind: [u8; 4]) -> Result<Option<Vec<u8>>, ExportError> {
+fn private_chunk(
+    mut file: impl std::io::Read,
+    path: &Path,
+    kind: [u8; 4],
+) -> Result<Option<Vec<u8>>, ExportError> {
     use std::io::Read;
     let decode = |message: &str| ExportError::Decode {
         path: path.to_owned(),
         message: message.to_owned(),
     };
-    let mut file =
-        std::io::BufReader::new(
-            std::fs::File::open(path).map_err(|source| ExportError::Read {
-                path: path.to_owned(),
-                source,
-            })?,
-        );
     let read_error = |source| ExportError::Read {
         path: path.to_owned(),
         source,

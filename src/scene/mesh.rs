@@ -10,8 +10,8 @@ use super::polygon::{DroppedPolygons, triangulate};
 use crate::material::Material;
 use crate::math::DVec3;
 
-/// Where mesh files come from: the file system, or memory for scenes
-/// embedded in the binary.
+/// Where scene and mesh files come from: the file system, or memory for
+/// scenes embedded in the binary (and for the fuzz targets).
 pub trait MeshSource {
     fn read(&self, path: &Path) -> std::io::Result<Vec<u8>>;
 }
@@ -19,7 +19,15 @@ pub trait MeshSource {
 pub struct FileSystem;
 
 impl MeshSource for FileSystem {
+    /// Regular files only: a scene naming `/dev/zero` or a pipe as its
+    /// mesh would otherwise read forever.
     fn read(&self, path: &Path) -> std::io::Result<Vec<u8>> {
+        if !std::fs::metadata(path)?.is_file() {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "not a regular file",
+            ));
+        }
         std::fs::read(path)
     }
 }

@@ -23,10 +23,15 @@ pub use polygon::DroppedPolygons;
 /// Loads a `.toml` or `.nff` scene file, or an `.obj` model in a scene
 /// glint writes around it.
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
+    load_with(path, &FileSystem)
+}
+
+/// Like [`load`], reading the scene file and its meshes from `files`.
+pub fn load_with(path: &Path, files: &dyn MeshSource) -> Result<Scene, SceneError> {
     if extension(path).as_deref() == Some("obj") {
-        return obj_scene::load(path, &mesh::FileSystem);
+        return obj_scene::load(path, files);
     }
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
+    let bytes = files.read(path).map_err(|source| SceneError::Io {
         path: path.to_owned(),
         source,
     })?;
@@ -34,7 +39,7 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
         path: path.to_owned(),
         offset: e.utf8_error().valid_up_to(),
     })?;
-    load_str(&text, path, &mesh::FileSystem)
+    load_str(&text, path, files)
 }
 
 fn extension(path: &Path) -> Option<String> {
