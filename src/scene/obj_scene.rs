@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use crate::camera::CameraSpec;
-use crate::math::DVec3;
+use crate::math::{Aabb, DVec3};
 
 use super::mesh::MeshSource;
 use super::model::{Scene, SceneError};
@@ -23,7 +23,9 @@ fn wrapper_text(path: &Path, camera: &CameraSpec, light: DVec3) -> String {
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     let quoted = toml::Value::String(file.clone()).to_string();
-    let v = |p: DVec3| format!("[{}, {}, {}]", p.x, p.y, p.z);
+    // `{:?}` writes 1e300 as `1e300` (TOML reads it back as the same
+    // double), where `{}` would write 301 digits TOML takes for an integer.
+    let v = |p: DVec3| format!("[{:?}, {:?}, {:?}]", p.x, p.y, p.z);
     format!(
         "# The scene glint writes around {file} when it is opened directly: the\n\
          # model in its own materials, a camera that frames it, one light over\n\
@@ -77,11 +79,45 @@ pub(super) fn load(path: &Path, files: &dyn MeshSource) -> Result<Scene, SceneEr
         },
         other => other,
     })?;
-    let bounds = scene.geometry_bounds();
-    let center = bounds.center();
-    let radius = (0.5 * bounds.extent().length()).max(f64::MIN_POSITIVE);
-    // Seen from the front (+z, the usual forward of OBJ exports), a little
-    // from above, far enough that the bounding sphere fits the view.
+    let (camera, light) = frame(scene.geometry_bounds()).ok_or_else(|| SceneError::Model {
+        path: path.to_owned(),
+        message: "the model's coordinates are too large to frame with a camera \
+                  (the camera would stand beyond the largest double)"
+            .into(),
+    })?;
+    let text = wrapper_text(path, &camera, light);
+    scene.camera = camera;
+    if let Some(l) = scene.lights.first_mut() {
+        l.position = light;
+    }
+    scene.source_text = std::sync::Arc::from(text.as_str());
+    Ok(scene)
+}
+
+/// A camera that frames `bounds` and a light over its shoulder: seen from
+/// the front (+z, the usual forward of OBJ exports), a little from above,
+/// far enough that the bounding sphere fits the view. `None` if that place
+/// is not a finite number (a model reaching 1e300).
+fn frame(bounds: Aabb) -> Option<(CameraSpec, DVec3)> {
+    // A model with no faces (only lines or points): the unit box.
+    let bounds = if bounds.is_empty() {
+        Aabb::new(DVec3::splat(-1.0), DVec3::splat(1.0))
+    } else {
+        bounds
+    };
+    // Halves first: min + max overflows for a model spanning 1e308.
+    let center = 0.5 * bounds.min + 0.5 * bounds.max;
+    let extent = bounds.max - bounds.min;
+    let largest = extent.max_element();
+    // Scaled, so the squares of a 1e200 model do not overflow.
+    let radius = if largest > 0.0 {
+        0.5 * largest * (extent / largest).length()
+    } else {
+        0.0
+    };
+    // A point model, or one far smaller than its distance from the origin,
+    // still needs an eye apart from the lookat point.
+    let radius = radius.max(center.abs().max_element() * 1e-9).max(1e-150);
     let direction = DVec3::new(0.0, 0.25, 1.0).normalize();
     let distance = radius / (0.5 * FOV.to_radians()).sin() * 1.05;
     let camera = CameraSpec {
@@ -91,13 +127,7 @@ pub(super) fn load(path: &Path, files: &dyn MeshSource) -> Result<Scene, SceneEr
         fov: FOV,
     };
     let light = center + DVec3::new(-0.5, 1.0, 0.8).normalize() * (distance * 1.5);
-    let text = wrapper_text(path, &camera, light);
-    scene.camera = camera;
-    if let Some(l) = scene.lights.first_mut() {
-        l.position = light;
-    }
-    scene.source_text = std::sync::Arc::from(text.as_str());
-    Ok(scene)
+    (camera.eye.is_finite() && light.is_finite()).then_some((camera, light))
 }
 
 /// Parses `text`, the TOML an OBJ file `path` was opened with (an
@@ -133,5 +163,36 @@ mod tests {
         assert_eq!(again.camera, scene.camera);
         assert_eq!(again.lights, scene.lights);
         assert_eq!(again.materials, scene.materials);
+    }
+
+    /// Found by `tests/round_trip.rs`: models the framing overflowed wrote
+    /// `NaN` (or 301-digit integers) into the scene text, which then did
+    /// not load again.
+    #[test]
+    fn extreme_models_are_framed_with_finite_numbers_or_refused() {
+        struct One(&'static [u8]);
+        impl MeshSource for One {
+            fn read(&self, _: &Path) -> std::io::Result<Vec<u8>> {
+                Ok(self.0.to_vec())
+            }
+        }
+        let path = Path::new("m.obj");
+        for model in [
+            &b"v 1e300 0 0\nv 0 1e300 0\nv 0 0 1e300\nf 1 2 3\n"[..],
+            b"v -1e200 0 0\nv 1e200 0 0\nv 0 1e200 0\nf 1 2 3\n",
+            b"v 1e6 0 0\nv 1e6 1e-9 0\nv 1e6 0 1e-9\nf 1 2 3\n",
+            // Its only face is dropped (its area overflows): nothing to frame.
+            b"v 0 0 0\nv 1.5e308 0 0\nv 0 1.5e308 0\nf 1 2 3\n",
+        ] {
+            let scene = load(path, &One(model)).unwrap();
+            assert!(scene.camera.eye.is_finite() && scene.camera.eye != scene.camera.lookat);
+            let again = reload(&scene.source_text, path, &One(model)).unwrap();
+            assert_eq!(again.camera, scene.camera);
+            assert_eq!(again.lights, scene.lights);
+        }
+        // Bounds the camera would have to stand beyond the largest double
+        // to see (no triangle reaches them: a face this size overflows its
+        // area and is dropped at load).
+        assert!(frame(Aabb::new(DVec3::ZERO, DVec3::splat(1.5e308))).is_none());
     }
 }
