@@ -151,7 +151,10 @@ const MODEL: &[u8] = b"mtllib model.mtl\nv -1 0 -1\nv 1 0 -1\nv 1 0.5 1\nv -1 0 
 usemtl red\nf 1//1 2//1 3//1\nusemtl blue\nf 1 3 4\n";
 const LIBRARY: &[u8] = b"newmtl red\nKd 0.8 0.1 0.1\nnewmtl blue\nKd 0.1 0.1 0.8\nNi 1.4\nd 0.5\n";
 
-fn edits_strategy() -> impl Strategy<Value = (Vec<(DVec3, DVec3)>, Vec<(DVec3, f64, f64)>)> {
+/// Edited lights (position, colour) and materials (colour, kd, shininess).
+type Edits = (Vec<(DVec3, DVec3)>, Vec<(DVec3, f64, f64)>);
+
+fn edits_strategy() -> impl Strategy<Value = Edits> {
     let v = |s: std::ops::RangeInclusive<f64>| {
         (s.clone(), s.clone(), s).prop_map(|(x, y, z)| DVec3::new(x, y, z))
     };
