@@ -1,6 +1,7 @@
 //! Every scene text glint writes loads back to the same scene: the scene
-//! inside an export's record (with the viewer's light and material edits)
-//! and the scene glint writes around an OBJ model opened on its own.
+//! inside an export's record (with the viewer's light and material edits),
+//! the scene glint writes around an OBJ model opened on its own, and a
+//! scene saved with the viewer's edits.
 
 mod common;
 
@@ -220,5 +221,75 @@ proptest! {
         let again = glint::scene::load_str(&scene.source_text, path, &files)
             .map_err(|e| TestCaseError::fail(format!("{e}\n{}", scene.source_text)))?;
         assert_same(&scene, &again)?;
+    }
+
+    /// A scene saved with edits (camera, image settings, the octree switch,
+    /// lights, the file's materials) loads back with exactly those values,
+    /// in its own folder or another; edits to a mesh's MTL materials are
+    /// named as left out, and the saved file keeps the MTL's values.
+    #[test]
+    fn a_scene_saved_with_edits_loads_back_with_them(
+        text in scene_text(),
+        edits in edits_strategy(),
+        eye in vec3(number()),
+        fov in 0.5..179.0f64,
+        size in (1u32..4096, 1u32..4096),
+        aa in 0usize..3,
+        max_depth in 1u32..=64,
+        octree in any::<bool>(),
+        other_folder in any::<bool>(),
+    ) {
+        let files = Files { scene: text.clone(), obj: MODEL.to_vec(), mtl: LIBRARY.to_vec() };
+        let path = Path::new("dir/scene.toml");
+        let loaded = match glint::scene::load_with(path, &files) {
+            Ok(s) => s,
+            Err(e) => return Err(TestCaseError::reject(e.to_string())),
+        };
+        let mut camera = loaded.camera;
+        camera.eye = DVec3::from(eye);
+        camera.fov = fov;
+        if camera.check().is_err() {
+            return Err(TestCaseError::reject("camera"));
+        }
+        let mut settings = loaded.render_settings();
+        (settings.width, settings.height) = size;
+        (settings.samples, settings.adaptive) = [(1, false), (16, false), (16, true)][aa];
+        settings.max_depth = max_depth;
+        settings.use_octree = octree;
+        let lights: Vec<Light> = loaded.lights.iter().zip(&edits.0).map(|(_, (p, c))| Light { position: *p, color: *c }).collect();
+        let materials: Vec<Material> = loaded.materials.iter().zip(edits.1.iter().cycle()).map(|(m, (c, kd, n))| Material { color: *c, kd: *kd, shininess: *n, ..m.clone() }).collect();
+        let request = glint::scene::save::SaveRequest {
+            loaded: &loaded,
+            loaded_path: path,
+            camera: &camera,
+            lights: &lights,
+            materials: &materials,
+            settings: &settings,
+            mesh_paths: glint::scene::save::MeshPaths::Anchored,
+        };
+        let destination = if other_folder { Path::new("elsewhere/saved.toml") } else { Path::new("dir/saved.toml") };
+        let saved = glint::scene::save::scene_toml(&request, destination).unwrap();
+        let again = glint::scene::load_str(&saved.text, destination, &files)
+            .map_err(|e| TestCaseError::fail(format!("{e}\n{}", saved.text)))?;
+        let mut expected = loaded.clone();
+        expected.camera = camera;
+        expected.lights = lights;
+        (expected.image.width, expected.image.height) = size;
+        (expected.image.samples, expected.image.adaptive) = (settings.samples, settings.adaptive);
+        expected.image.max_depth = max_depth;
+        expected.octree_enabled = octree;
+        // The file's own materials come first; the mesh's MTL ones follow.
+        let own = text.matches("[materials.").count();
+        let mut left_out = Vec::new();
+        for (i, m) in materials.iter().enumerate() {
+            if i < own {
+                expected.materials[i] = m.clone();
+            } else if *m != loaded.materials[i] {
+                left_out.push(m.name.clone());
+            }
+        }
+        prop_assert_eq!(&saved.left_out_materials, &left_out);
+        assert_same(&expected, &again)?;
+        prop_assert_eq!(again.render_settings(), settings);
     }
 }

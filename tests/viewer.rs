@@ -534,3 +534,123 @@ fn a_typed_number_is_taken_on_enter() {
     assert_eq!(h.state().settings().width, 200);
     assert!(h.state().worker().generation() > generation);
 }
+
+/// A scene file in a fresh folder, its size small enough for UI tests.
+fn scene_in_temp_folder() -> (tempfile::TempDir, std::path::PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(common::repo_path("scenes/sphere.toml"))
+        .unwrap()
+        .replace("width = 400\nheight = 300", "width = 64\nheight = 48");
+    let path = dir.path().join("sphere.toml");
+    std::fs::write(&path, text).unwrap();
+    (dir, path)
+}
+
+fn press(h: &mut Harness<'static, GlintApp>, modifiers: egui::Modifiers, key: egui::Key) {
+    h.key_press_modifiers(modifiers, key);
+    h.run_steps(2);
+}
+
+/// Edits can be undone and redone, are marked in the title until saved,
+/// and Save writes them into the scene file, comments kept; a reload over
+/// unsaved edits asks first.
+#[test]
+fn edits_undo_redo_save_and_a_reload_that_asks() {
+    use egui::{Key, Modifiers};
+    let (_dir, path) = scene_in_temp_folder();
+    let app = GlintApp::new(
+        SceneSource::File(path.clone()),
+        ViewerOptions::default(),
+        || {},
+    )
+    .unwrap();
+    let mut h = harness(app);
+    assert!(!h.state().unsaved());
+    assert!(!h.state().title().starts_with('●'), "{}", h.state().title());
+    let original = h.state().scene().lights.clone();
+    let edited = glint::math::DVec3::new(0.25, 0.5, 0.75);
+    h.state_mut().scene_mut().lights[0].color = edited;
+    h.state_mut().settings_mut().max_depth = 7;
+    h.run_steps(2);
+    assert!(h.state().unsaved());
+    assert!(h.state().title().starts_with('●'), "{}", h.state().title());
+
+    press(&mut h, Modifiers::COMMAND, Key::Z);
+    assert_eq!(
+        h.state().scene().lights,
+        original,
+        "undo restores the light"
+    );
+    assert_eq!(
+        h.state().settings().max_depth,
+        3,
+        "and the depth, changed in the same moment"
+    );
+    assert!(!h.state().unsaved());
+    press(&mut h, Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+    assert_eq!(
+        h.state().scene().lights[0].color,
+        edited,
+        "redo puts it back"
+    );
+    assert_eq!(h.state().settings().max_depth, 7);
+
+    press(&mut h, Modifiers::COMMAND, Key::S);
+    assert!(!h.state().unsaved(), "{:?}", h.state().messages().last());
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(
+        text.starts_with("# One sphere on a plane"),
+        "comments kept:\n{text}"
+    );
+    let saved = glint::scene::load(&path).unwrap();
+    assert_eq!(saved.lights[0].color, edited);
+    assert_eq!(saved.image.max_depth, 7);
+    assert!(
+        h.state()
+            .messages()
+            .last()
+            .unwrap()
+            .text
+            .starts_with("saved ")
+    );
+
+    // Unsaved again: F5 asks, Cancel keeps the edit, Discard reloads the file.
+    h.state_mut().scene_mut().lights[0].color = original[0].color;
+    h.run_steps(2);
+    press(&mut h, Modifiers::NONE, Key::F5);
+    h.get_by_label("Unsaved edits");
+    h.get_by_label("Cancel").click();
+    h.run_steps(2);
+    assert_eq!(h.state().scene().lights, original, "cancel keeps the edit");
+    press(&mut h, Modifiers::NONE, Key::F5);
+    h.get_by_label("Discard").click();
+    h.run_steps(2);
+    assert_eq!(
+        h.state().scene().lights[0].color,
+        edited,
+        "the saved file was reloaded"
+    );
+    assert!(!h.state().unsaved());
+}
+
+/// The built-in scene has no file: Save writes a new TOML scene (with the
+/// bunny beside it) that loads to the same scene.
+#[test]
+fn the_built_in_scene_is_saved_as_a_new_file_with_its_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let app = GlintApp::new(SceneSource::BuiltIn, ViewerOptions::default(), || {}).unwrap();
+    let mut h = harness(app);
+    let mut camera = *h.state().camera();
+    camera.fov = 33.0;
+    *h.state_mut().camera_mut() = camera;
+    h.run_steps(1);
+    let path = dir.path().join("copy.toml");
+    h.state_mut().save_to(&path);
+    assert!(!h.state().unsaved(), "{:?}", h.state().messages().last());
+    let copy = glint::scene::load(&path).unwrap();
+    let builtin = glint::scene::builtin::default_scene().unwrap();
+    assert_eq!(copy.camera, camera);
+    assert_eq!(copy.shapes, builtin.shapes);
+    assert_eq!(copy.materials, builtin.materials);
+    assert!(dir.path().join("bunny.obj").is_file());
+}

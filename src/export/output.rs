@@ -110,6 +110,7 @@ fn folder_of(file: &Path) -> PathBuf {
 fn temporary_with(
     dir: &Path,
     permissions: std::fs::Permissions,
+    suffix: &str,
 ) -> std::io::Result<tempfile::NamedTempFile> {
     // The folder first, for the system's own words ("No such file or
     // directory", "Not a directory").
@@ -119,7 +120,7 @@ fn temporary_with(
     }
     tempfile::Builder::new()
         .prefix(".glint-")
-        .suffix(".png.tmp")
+        .suffix(suffix)
         .permissions(permissions)
         .tempfile_in(dir)
         .map_err(|e| without_path(&e))
@@ -135,7 +136,7 @@ fn without_path(e: &std::io::Error) -> std::io::Error {
 
 fn temporary_in(dir: &Path) -> std::io::Result<tempfile::NamedTempFile> {
     use std::os::unix::fs::PermissionsExt;
-    temporary_with(dir, std::fs::Permissions::from_mode(0o600))
+    temporary_with(dir, std::fs::Permissions::from_mode(0o600), ".png.tmp")
 }
 
 /// The file a new output named `path` creates: `path` itself, or the
@@ -196,11 +197,8 @@ pub fn save_rgb_png(
             let dir = folder_of(&target);
             // A replaced file keeps its permissions; a new one gets the
             // usual 0666 less the umask (tempfile's own default is 0600).
-            use std::os::unix::fs::PermissionsExt;
-            let permissions = std::fs::metadata(&target)
-                .map(|m| m.permissions())
-                .unwrap_or_else(|_| std::fs::Permissions::from_mode(0o666));
-            let tmp = temporary_with(&dir, permissions).map_err(write_error)?;
+            let tmp =
+                temporary_with(&dir, kept_permissions(&target), ".png.tmp").map_err(write_error)?;
             {
                 let mut w = std::io::BufWriter::new(tmp.as_file());
                 write_png(&mut w, path, width, height, rgb, record)?;
@@ -213,4 +211,44 @@ pub fn save_rgb_png(
             Ok(())
         }
     }
+}
+
+/// The permissions a file written over `target` gets: the old file's, or
+/// for a new one the usual 0666 less the umask (tempfile's own default is
+/// 0600).
+fn kept_permissions(target: &Path) -> std::fs::Permissions {
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::metadata(target)
+        .map(|m| m.permissions())
+        .unwrap_or_else(|_| std::fs::Permissions::from_mode(0o666))
+}
+
+/// Writes `bytes` to the regular file `path` (following symbolic links)
+/// through a temporary file renamed into place: a failed write leaves the
+/// old file whole. Used for saved scenes.
+pub fn write_file_atomically(path: &Path, bytes: &[u8]) -> Result<(), ExportError> {
+    let write_error = |source| ExportError::Write {
+        path: path.to_owned(),
+        source,
+    };
+    let target = match OutputTarget::resolve(path)? {
+        OutputTarget::File(target) => target,
+        _ => {
+            return Err(write_error(std::io::Error::other(
+                "it is not a regular file",
+            )));
+        }
+    };
+    let tmp = temporary_with(&folder_of(&target), kept_permissions(&target), ".tmp")
+        .map_err(write_error)?;
+    {
+        use std::io::Write;
+        let mut file = tmp.as_file();
+        file.write_all(bytes)
+            .and_then(|()| file.sync_all())
+            .map_err(write_error)?;
+    }
+    tmp.persist(&target)
+        .map_err(|e| write_error(without_path(&e.error)))?;
+    Ok(())
 }

@@ -5,7 +5,9 @@ use std::path::Path;
 use crate::scene::{MeshSource, Scene, SceneError};
 
 pub const DEFAULT_SCENE: &str = include_str!("../../scenes/default.toml");
-const BUNNY_OBJ: &[u8] = include_bytes!("../../assets/bunny.obj");
+/// The mesh the built-in scene uses, and its file name.
+pub const MESH: &[u8] = include_bytes!("../../assets/bunny.obj");
+pub const MESH_NAME: &str = "bunny.obj";
 /// How the built-in scene is named in messages and exports.
 pub const NAME: &str = "scenes/default.toml (built in)";
 
@@ -13,8 +15,8 @@ struct Embedded;
 
 impl MeshSource for Embedded {
     fn read(&self, path: &Path) -> std::io::Result<Vec<u8>> {
-        if path.file_name().is_some_and(|n| n == "bunny.obj") {
-            Ok(BUNNY_OBJ.to_vec())
+        if path.file_name().is_some_and(|n| n == MESH_NAME) {
+            Ok(MESH.to_vec())
         } else {
             Err(std::io::Error::new(
                 std::io::ErrorKind::NotFound,

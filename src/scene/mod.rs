@@ -10,6 +10,7 @@ pub mod nff;
 mod obj;
 mod obj_scene;
 pub mod polygon;
+pub mod save;
 pub mod toml_format;
 
 use std::path::Path;

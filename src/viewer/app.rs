@@ -14,10 +14,10 @@ use super::inspect::InspectState;
 use super::panels::{Message, RenderInfo};
 use super::pixel::Inspection;
 use super::screenshot::Screenshot;
-use super::state::EditState;
 pub use super::state::{CompareSetting, SceneSource};
+use super::state::{EditState, Snapshot};
 use super::worker::{Job, Preview, Worker};
-use super::{budget, export, input, panels, timing};
+use super::{budget, export, input, panels, save, timing};
 use crate::accel::Octree;
 use crate::camera::CameraSpec;
 use crate::scene::Scene;
@@ -56,9 +56,26 @@ struct RenderInputs {
     preview: Option<Preview>,
 }
 
+/// What waits for the user to confirm that unsaved edits may go.
+#[derive(Clone, Debug, PartialEq)]
+enum Discarding {
+    Reload,
+    Open(PathBuf),
+    Quit,
+}
+
 pub struct GlintApp {
     /// What the user edits.
     edit: EditState,
+    /// Undo and redo over every edit (camera, settings, lights, materials);
+    /// changes within a second of each other are one step.
+    undoer: egui::util::undoer::Undoer<Snapshot>,
+    /// The edits as last loaded or saved: the title marks any difference.
+    saved: Snapshot,
+    /// An action that would drop unsaved edits, waiting for the user's word.
+    discarding: Option<Discarding>,
+    /// The window title last sent.
+    title: String,
     // The runtime: the octree of the scene, the render worker and what
     // is on screen.
     octree: Arc<Octree>,
@@ -98,16 +115,24 @@ impl GlintApp {
         let mut edit = EditState {
             camera: scene.camera,
             source,
+            loaded: Arc::new(scene.clone()),
             scene: Arc::new(scene),
             scene_version: 0,
             settings,
             frame_budget_ms: 33.0,
         };
+        // Before `--compare` flips a setting for its A image: B, which
+        // follows, is the state as loaded.
+        let saved = edit.snapshot();
         if let Some(setting) = options.compare {
             edit.flip(setting);
         }
         let mut app = Self {
             edit,
+            undoer: Default::default(),
+            saved,
+            discarding: None,
+            title: String::new(),
             octree: Arc::new(octree),
             build_seconds,
             worker,
@@ -167,6 +192,10 @@ impl GlintApp {
     /// Mutable access to lights and materials; marks the image stale.
     pub fn scene_mut(&mut self) -> &mut Scene {
         self.edit.scene_mut()
+    }
+
+    pub fn camera_mut(&mut self) -> &mut CameraSpec {
+        &mut self.edit.camera
     }
 
     pub fn camera(&self) -> &CameraSpec {
@@ -256,9 +285,22 @@ impl GlintApp {
         }
         self.update_texture(&ctx);
         let mut commands = input::shortcuts(&ctx);
-        egui::Panel::top("menu").show(ui, |ui| {
-            commands.extend(panels::menu_ui(&self.edit.scene.name, ui))
-        });
+        if self.discarding.is_none()
+            && ctx.input(|i| i.viewport().close_requested())
+            && self.unsaved()
+            && self.screenshot.is_none()
+        {
+            ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
+            self.discarding = Some(Discarding::Quit);
+        }
+        let snapshot = self.edit.snapshot();
+        let menu = panels::MenuState {
+            scene_name: &self.edit.scene.name,
+            unsaved: self.unsaved(),
+            can_undo: self.undoer.has_undo(&snapshot),
+            can_redo: self.undoer.has_redo(&snapshot),
+        };
+        egui::Panel::top("menu").show(ui, |ui| commands.extend(panels::menu_ui(&menu, ui)));
         let info = RenderInfo {
             worker: &self.worker,
             octree: &self.octree,
@@ -287,7 +329,11 @@ impl GlintApp {
                 timing::timing_ui(&self.edit, &info, &self.inspect, ui)
             });
         egui::CentralPanel::default_margins().show(ui, |ui| commands.extend(self.image_ui(ui)));
+        self.discard_prompt_ui(&ctx);
         self.apply(commands, &ctx);
+        self.undoer
+            .feed_state(ctx.input(|i| i.time), &self.edit.snapshot());
+        self.title_logic(&ctx);
         self.compare_logic();
         self.sync_render();
         self.screenshot_logic(&ctx);
@@ -348,8 +394,23 @@ impl GlintApp {
         for command in commands {
             match command {
                 Command::ResetCamera => self.edit.camera = self.edit.scene.camera,
+                Command::Reload if self.unsaved() => self.discarding = Some(Discarding::Reload),
                 Command::Reload => self.reload(),
                 Command::Open => self.open_dialog(),
+                Command::Save => self.save(),
+                Command::SaveAs => self.save_as(),
+                Command::Undo => {
+                    let now = self.edit.snapshot();
+                    if let Some(s) = self.undoer.undo(&now).cloned() {
+                        self.edit.restore(&s);
+                    }
+                }
+                Command::Redo => {
+                    let now = self.edit.snapshot();
+                    if let Some(s) = self.undoer.redo(&now).cloned() {
+                        self.edit.restore(&s);
+                    }
+                }
                 Command::Export => self.export(),
                 Command::InspectPixel(i, j) => self.inspect_pixel(i, j),
                 Command::PinAsA => self.pin_as_a(),
@@ -454,6 +515,129 @@ impl GlintApp {
         }
     }
 
+    /// Whether the edits differ from the scene as last loaded or saved.
+    pub fn unsaved(&self) -> bool {
+        self.edit.snapshot().differs_in_saved_values(&self.saved)
+    }
+
+    /// The window title: the scene, marked while it has unsaved edits.
+    fn title_logic(&mut self, ctx: &egui::Context) {
+        let mark = if self.unsaved() { "● " } else { "" };
+        let title = format!("{mark}{} — glint", self.edit.source.display_name());
+        if title != self.title {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Title(title.clone()));
+            self.title = title;
+        }
+    }
+
+    /// The window title as last set.
+    pub fn title(&self) -> &str {
+        &self.title
+    }
+
+    /// Asks before an action drops unsaved edits.
+    fn discard_prompt_ui(&mut self, ctx: &egui::Context) {
+        let Some(action) = self.discarding.clone() else {
+            return;
+        };
+        let verb = match &action {
+            Discarding::Reload => "reload the scene file",
+            Discarding::Open(_) => "open another scene",
+            Discarding::Quit => "quit",
+        };
+        let mut choice = None;
+        egui::Modal::new(egui::Id::unique("discard-edits")).show(ctx, |ui| {
+            ui.heading("Unsaved edits");
+            ui.label(format!(
+                "{} has edits that are not saved. Discard them and {verb}?",
+                self.edit.source.display_name()
+            ));
+            ui.horizontal(|ui| {
+                if ui.button("Save first").clicked() {
+                    choice = Some(true);
+                }
+                if ui.button("Discard").clicked() {
+                    choice = Some(false);
+                }
+                if ui.button("Cancel").clicked() || ui.input(|i| i.key_pressed(egui::Key::Escape)) {
+                    self.discarding = None;
+                }
+            });
+        });
+        let Some(save_first) = choice else {
+            return;
+        };
+        self.discarding = None;
+        if save_first {
+            self.save();
+            if self.unsaved() {
+                return; // not saved (cancelled or failed): do nothing more
+            }
+        }
+        match action {
+            Discarding::Reload => self.reload(),
+            Discarding::Open(path) => self.open(path),
+            Discarding::Quit => {
+                self.saved = self.edit.snapshot();
+                ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+            }
+        }
+    }
+
+    /// Writes the edits into the scene's TOML file; a scene without one
+    /// (built in, an OBJ or NFF file) is saved as a new file.
+    pub fn save(&mut self) {
+        match self.edit.source.path() {
+            Some(p) if save::saves_in_place(&self.edit.source) => {
+                let p = p.to_owned();
+                self.save_to(&p)
+            }
+            _ => self.save_as(),
+        }
+    }
+
+    /// Writes the scene with its edits to a new TOML file and goes on
+    /// editing that file.
+    pub fn save_as(&mut self) {
+        if let Some(path) = save::choose_path(&self.edit.source) {
+            self.save_to(&path);
+        }
+    }
+
+    /// Saves to `path`; the saved file becomes the scene's source.
+    pub fn save_to(&mut self, path: &Path) {
+        match save::save(&self.edit, path) {
+            Ok(saved) => {
+                let shown = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_owned());
+                let name = saved.scene.name.clone();
+                self.edit.loaded = Arc::new(saved.scene);
+                self.edit.source = SceneSource::File(path.to_owned());
+                // The scene text exports record is now the saved file's
+                // (no re-render: the picture is the same).
+                let scene = Arc::make_mut(&mut self.edit.scene);
+                scene.source_text = Arc::clone(&self.edit.loaded.source_text);
+                scene.name = name;
+                let mut baseline = self.edit.snapshot();
+                if saved.left_out_materials.is_empty() {
+                    self.say(format!("saved {}", shown.display()), false);
+                } else {
+                    // Those materials stay marked as unsaved.
+                    baseline.materials.clone_from(&self.edit.loaded.materials);
+                    self.say(
+                        format!(
+                            "saved {}, without the edits to {}: a TOML scene takes a mesh's materials from its .mtl file (export a PNG to keep them)",
+                            shown.display(),
+                            saved.left_out_materials.join(", ")
+                        ),
+                        true,
+                    );
+                }
+                self.saved = baseline;
+            }
+            Err(e) => self.say(format!("cannot save {}: {e:#}", path.display()), true),
+        }
+    }
+
     /// Re-reads the scene file, keeping the camera; a failure keeps the
     /// current scene on screen.
     pub fn reload(&mut self) {
@@ -463,7 +647,15 @@ impl GlintApp {
             .load()
             .and_then(|scene| self.install_scene(scene, false))
         {
-            Ok(()) => self.say(format!("reloaded {}", self.edit.scene.name), false),
+            Ok(()) => {
+                // The camera stays where the user put it, which the file
+                // may not say.
+                self.saved = Snapshot {
+                    camera: self.edit.loaded.camera,
+                    ..self.edit.snapshot()
+                };
+                self.say(format!("reloaded {}", self.edit.scene.name), false)
+            }
             Err(e) => self.say(
                 format!("reload failed, keeping the previous scene: {e:#}"),
                 true,
@@ -480,6 +672,7 @@ impl GlintApp {
         {
             Ok(()) => {
                 self.edit.source = source;
+                self.saved = self.edit.snapshot();
                 self.say(format!("opened {}", self.edit.scene.name), false);
                 for note in self.edit.scene.notes() {
                     self.say(format!("note: {note}"), false);
@@ -503,8 +696,12 @@ impl GlintApp {
             }
             .with_protocol(edit.settings.protocol);
         }
+        edit.loaded = Arc::new(scene.clone());
         edit.scene = Arc::new(scene);
         edit.scene_version += 1;
+        // Undo does not reach into another scene (or an earlier version
+        // of this one).
+        self.undoer = Default::default();
         self.octree = Arc::new(octree);
         self.build_seconds = seconds;
         Ok(())
@@ -519,7 +716,11 @@ impl GlintApp {
             .add_filter("scenes and models", &["toml", "nff", "obj"])
             .pick_file()
         {
-            self.open(path);
+            if self.unsaved() {
+                self.discarding = Some(Discarding::Open(path));
+            } else {
+                self.open(path);
+            }
         }
     }
 

@@ -8,6 +8,15 @@ pub enum Command {
     Open,
     /// Read the scene file again, keeping the camera.
     Reload,
+    /// Write the edits into the scene file (or ask where, for a scene
+    /// that has no TOML file of its own).
+    Save,
+    /// Write the scene with its edits to a new TOML file.
+    SaveAs,
+    /// Step back through the edits.
+    Undo,
+    /// Step forward again.
+    Redo,
     /// Write the frame on screen to a PNG.
     Export,
     /// Back to the scene's camera.

@@ -89,7 +89,7 @@ pub fn file_dialog_available() -> bool {
 }
 
 /// A readable UTC timestamp for file names, e.g. `2026-11-23T14-05-09Z`.
-fn timestamp() -> String {
+pub(super) fn timestamp() -> String {
     let secs = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0, |d| d.as_secs());
@@ -144,10 +144,17 @@ fn export_dir(source: &SceneSource) -> PathBuf {
     if let Some(dir) = pictures.filter(|d| d.is_dir()) {
         return dir;
     }
-    if let SceneSource::File(p) = source
-        && let Some(dir) = p.parent().filter(|d| d.is_dir())
-    {
-        return std::path::absolute(dir).unwrap_or_else(|_| dir.to_owned());
+    if let SceneSource::File(p) = source {
+        // A bare name (`glint view sphere.toml`) is in the working folder.
+        let dir = match p.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        if let Ok(dir) = std::fs::canonicalize(dir)
+            && dir.is_dir()
+        {
+            return dir;
+        }
     }
     std::env::temp_dir()
 }

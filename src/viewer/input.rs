@@ -8,26 +8,57 @@ use super::command::Command;
 use super::orbit;
 use crate::camera::CameraSpec;
 
-/// Keyboard shortcuts; R only when no text field has the focus.
+/// Keyboard shortcuts; R, undo and redo only when no text field has the
+/// focus (a field being typed in has its own undo).
 pub fn shortcuts(ctx: &egui::Context) -> Vec<Command> {
     let mut commands = Vec::new();
-    let open = KeyboardShortcut::new(Modifiers::COMMAND, Key::O);
-    let save = KeyboardShortcut::new(Modifiers::COMMAND, Key::S);
-    let reload = KeyboardShortcut::new(Modifiers::NONE, Key::F5);
+    let command_shift = Modifiers::COMMAND | Modifiers::SHIFT;
+    // A shortcut with Shift comes before the same one without: egui
+    // matches Ctrl+S on Ctrl+Shift+S too.
+    let mut table = vec![
+        (
+            KeyboardShortcut::new(Modifiers::COMMAND, Key::O),
+            Command::Open,
+        ),
+        (
+            KeyboardShortcut::new(command_shift, Key::S),
+            Command::SaveAs,
+        ),
+        (
+            KeyboardShortcut::new(Modifiers::COMMAND, Key::S),
+            Command::Save,
+        ),
+        (
+            KeyboardShortcut::new(Modifiers::COMMAND, Key::E),
+            Command::Export,
+        ),
+        (
+            KeyboardShortcut::new(Modifiers::NONE, Key::F5),
+            Command::Reload,
+        ),
+    ];
+    let typing = ctx.egui_wants_keyboard_input();
+    if !typing {
+        table.extend([
+            (KeyboardShortcut::new(command_shift, Key::Z), Command::Redo),
+            (
+                KeyboardShortcut::new(Modifiers::COMMAND, Key::Y),
+                Command::Redo,
+            ),
+            (
+                KeyboardShortcut::new(Modifiers::COMMAND, Key::Z),
+                Command::Undo,
+            ),
+        ]);
+    }
     ctx.input_mut(|i| {
-        for (shortcut, command) in [
-            (open, Command::Open),
-            (save, Command::Export),
-            (reload, Command::Reload),
-        ] {
+        for (shortcut, command) in table {
             if i.consume_shortcut(&shortcut) {
                 commands.push(command);
             }
         }
     });
-    if !ctx.egui_wants_keyboard_input()
-        && ctx.input(|i| i.key_pressed(Key::R) && i.modifiers.is_none())
-    {
+    if !typing && ctx.input(|i| i.key_pressed(Key::R) && i.modifiers.is_none()) {
         commands.push(Command::ResetCamera);
     }
     commands

@@ -14,6 +14,7 @@ pub mod inspect;
 mod orbit;
 mod panels;
 pub mod pixel;
+mod save;
 mod screenshot;
 pub mod state;
 mod timing;

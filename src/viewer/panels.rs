@@ -31,35 +31,47 @@ pub struct RenderInfo<'a> {
     pub message: Option<&'a Message>,
 }
 
-pub fn menu_ui(scene_name: &str, ui: &mut egui::Ui) -> Vec<Command> {
+/// What the menu bar shows besides its commands.
+pub struct MenuState<'a> {
+    pub scene_name: &'a str,
+    pub unsaved: bool,
+    pub can_undo: bool,
+    pub can_redo: bool,
+}
+
+pub fn menu_ui(state: &MenuState, ui: &mut egui::Ui) -> Vec<Command> {
     let mut commands = Vec::new();
+    let mut item = |ui: &mut egui::Ui, enabled: bool, label: &str, command: Command| {
+        if ui.add_enabled(enabled, egui::Button::new(label)).clicked() {
+            commands.push(command);
+            ui.close();
+        }
+    };
     egui::MenuBar::new().ui(ui, |ui| {
         ui.menu_button("File", |ui| {
-            if ui.button("Open scene…  (Ctrl+O)").clicked() {
-                commands.push(Command::Open);
-                ui.close();
-            }
-            if ui.button("Reload  (F5)").clicked() {
-                commands.push(Command::Reload);
-                ui.close();
-            }
-            if ui.button("Export PNG…  (Ctrl+S)").clicked() {
-                commands.push(Command::Export);
-                ui.close();
-            }
+            item(ui, true, "Open scene…  (Ctrl+O)", Command::Open);
+            item(ui, true, "Reload  (F5)", Command::Reload);
             ui.separator();
-            if ui.button("Quit").clicked() {
-                commands.push(Command::Quit);
-            }
+            item(ui, true, "Save scene  (Ctrl+S)", Command::Save);
+            item(ui, true, "Save scene as…  (Ctrl+Shift+S)", Command::SaveAs);
+            item(ui, true, "Export PNG…  (Ctrl+E)", Command::Export);
+            ui.separator();
+            item(ui, true, "Quit", Command::Quit);
+        });
+        ui.menu_button("Edit", |ui| {
+            item(ui, state.can_undo, "Undo  (Ctrl+Z)", Command::Undo);
+            item(ui, state.can_redo, "Redo  (Ctrl+Shift+Z)", Command::Redo);
         });
         ui.menu_button("View", |ui| {
-            if ui.button("Reset camera  (R)").clicked() {
-                commands.push(Command::ResetCamera);
-                ui.close();
-            }
+            item(ui, true, "Reset camera  (R)", Command::ResetCamera);
         });
         ui.separator();
-        ui.label(RichText::new(scene_name).weak());
+        let name = if state.unsaved {
+            format!("{} (edited, unsaved)", state.scene_name)
+        } else {
+            state.scene_name.to_owned()
+        };
+        ui.label(RichText::new(name).weak());
     });
     commands
 }

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use crate::camera::CameraSpec;
+use crate::material::{Light, Material};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 
@@ -29,6 +30,14 @@ impl SceneSource {
             SceneSource::BuiltIn => crate::scene::builtin::default_scene()?,
             SceneSource::File(p) => crate::scene::load(p)?,
         })
+    }
+
+    /// The scene file, if there is one.
+    pub fn path(&self) -> Option<&std::path::Path> {
+        match self {
+            SceneSource::BuiltIn => None,
+            SceneSource::File(p) => Some(p),
+        }
     }
 
     /// A short name for file names: the scene file's stem.
@@ -57,6 +66,10 @@ pub struct EditState {
     /// Shared with the render worker; edits copy lights and materials only
     /// (the geometry sits behind its own `Arc`).
     pub scene: Arc<Scene>,
+    /// The scene as its file describes it, before any edit: what "Save
+    /// scene" compares against (values equal to it stay as the file writes
+    /// them).
+    pub loaded: Arc<Scene>,
     /// Bumped whenever the scene changes, so the app can tell.
     pub scene_version: u64,
     pub camera: CameraSpec,
@@ -67,7 +80,64 @@ pub struct EditState {
     pub frame_budget_ms: f64,
 }
 
+/// Everything the user can edit, as one value: what undo and redo step
+/// through, and (in part) what a saved scene holds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Snapshot {
+    pub camera: CameraSpec,
+    pub settings: RenderSettings,
+    pub lights: Vec<Light>,
+    pub materials: Vec<Material>,
+}
+
+impl Snapshot {
+    /// Whether `self` and `other` differ in what "Save scene" writes: the
+    /// camera, lights, materials, image size, samples, depth, colours,
+    /// sides and the octree switch (not the view or the protocol, which
+    /// are ways of looking at the scene).
+    pub fn differs_in_saved_values(&self, other: &Snapshot) -> bool {
+        let saved = |s: &Snapshot| {
+            let r = &s.settings;
+            (
+                r.width,
+                r.height,
+                r.samples,
+                r.adaptive,
+                r.max_depth,
+                r.colors,
+                r.sides,
+                r.use_octree,
+            )
+        };
+        self.camera != other.camera
+            || self.lights != other.lights
+            || self.materials != other.materials
+            || saved(self) != saved(other)
+    }
+}
+
 impl EditState {
+    /// Everything the user has edited, as one value.
+    pub fn snapshot(&self) -> Snapshot {
+        Snapshot {
+            camera: self.camera,
+            settings: self.settings,
+            lights: self.scene.lights.clone(),
+            materials: self.scene.materials.clone(),
+        }
+    }
+
+    /// Puts back an earlier [`Snapshot`] (undo, redo).
+    pub fn restore(&mut self, s: &Snapshot) {
+        self.camera = s.camera;
+        self.settings = s.settings;
+        if self.scene.lights != s.lights || self.scene.materials != s.materials {
+            let scene = self.scene_mut();
+            scene.lights.clone_from(&s.lights);
+            scene.materials.clone_from(&s.materials);
+        }
+    }
+
     /// Mutable access to lights and materials; marks the image stale.
     pub fn scene_mut(&mut self) -> &mut Scene {
         self.scene_version += 1;

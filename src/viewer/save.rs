@@ -1,0 +1,117 @@
+//! "Save scene": the viewer's edits written into a TOML scene file (see
+//! [`crate::scene::save`]), atomically, then read back to prove it loads.
+
+use std::path::{Path, PathBuf};
+
+use super::export::file_dialog_available;
+use super::state::{EditState, SceneSource};
+use crate::scene::Scene;
+use crate::scene::save::{MeshPaths, SaveRequest, scene_toml};
+
+/// Whether "Save scene" can write into the scene's own file: only a TOML
+/// scene file can be edited in place (the built-in scene, an OBJ opened on
+/// its own and an NFF scene need a new file).
+pub fn saves_in_place(source: &SceneSource) -> bool {
+    source
+        .path()
+        .and_then(Path::extension)
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
+}
+
+/// Where "Save scene as" writes: chosen in a save dialog, or, without one,
+/// a new name beside the scene file (`NAME-edited.toml`, then
+/// `NAME-edited-2.toml`, ...). `None` when the user cancels.
+pub fn choose_path(source: &SceneSource) -> Option<PathBuf> {
+    let folder = match source.path().and_then(Path::parent) {
+        Some(d) if !d.as_os_str().is_empty() => d.to_owned(),
+        Some(_) => PathBuf::from("."),
+        None => std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
+    };
+    let stem = source.stem();
+    if file_dialog_available() {
+        let name = if saves_in_place(source) {
+            format!("{stem}-edited.toml")
+        } else {
+            format!("{stem}.toml")
+        };
+        return rfd::FileDialog::new()
+            .set_directory(&folder)
+            .set_file_name(&name)
+            .add_filter("glint scene", &["toml"])
+            .save_file();
+    }
+    (1..)
+        .map(|k| match k {
+            1 => folder.join(format!("{stem}-edited.toml")),
+            k => folder.join(format!("{stem}-edited-{k}.toml")),
+        })
+        .find(|p| !p.exists())
+}
+
+/// What a save did.
+pub struct Saved {
+    /// The saved file, loaded back: the new "as loaded" scene.
+    pub scene: Scene,
+    /// Edited materials the file could not hold (a mesh's MTL materials).
+    pub left_out_materials: Vec<String>,
+}
+
+/// Writes `edit` to `destination` as TOML and loads the file back.
+pub fn save(edit: &EditState, destination: &Path) -> anyhow::Result<Saved> {
+    let is_toml = destination
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+    anyhow::ensure!(
+        is_toml,
+        "name the scene file .toml (glint saves TOML scenes)"
+    );
+    let builtin = edit.source == SceneSource::BuiltIn;
+    let loaded_path = match edit.source.path() {
+        Some(p) => p.to_owned(),
+        None => PathBuf::from("scenes/default.toml"),
+    };
+    let request = SaveRequest {
+        loaded: &edit.loaded,
+        loaded_path: &loaded_path,
+        camera: &edit.camera,
+        lights: &edit.scene.lights,
+        materials: &edit.scene.materials,
+        settings: &edit.settings,
+        mesh_paths: if builtin {
+            MeshPaths::Beside
+        } else {
+            MeshPaths::Anchored
+        },
+    };
+    let saved = scene_toml(&request, destination)?;
+    if builtin {
+        write_builtin_mesh(destination)?;
+    }
+    crate::export::write_file_atomically(destination, saved.text.as_bytes())?;
+    let scene = crate::scene::load(destination)?;
+    Ok(Saved {
+        scene,
+        left_out_materials: saved.left_out_materials,
+    })
+}
+
+/// The built-in scene's mesh, written beside a copy of the scene (a file
+/// of that name already there must be the same mesh).
+fn write_builtin_mesh(destination: &Path) -> anyhow::Result<()> {
+    let folder = match destination.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mesh = folder.join(crate::scene::builtin::MESH_NAME);
+    match std::fs::read(&mesh) {
+        Ok(bytes) if bytes == crate::scene::builtin::MESH => Ok(()),
+        Ok(_) => anyhow::bail!(
+            "{} exists and is not the built-in scene's bunny; save the scene in another folder",
+            mesh.display()
+        ),
+        Err(_) => Ok(crate::export::write_file_atomically(
+            &mesh,
+            crate::scene::builtin::MESH,
+        )?),
+    }
+}
