@@ -118,16 +118,21 @@ pub fn draw_cells(rgb: &mut [u8], camera: &Camera, cells: &[OctreeCell]) {
 }
 
 /// The RGB8 picture of `frame` with the octree's cells down to level
-/// `depth` drawn over it, and a legend strip (the view's own, or else the
-/// overlay's colour scale). Returns the bytes and the height.
+/// `depth` drawn over it, and with `legend` a legend strip (the view's
+/// own, or else the overlay's colour scale). Returns the bytes and the
+/// height.
 pub fn annotate(
     frame: &crate::frame::Frame,
     camera: &Camera,
     cells: &[OctreeCell],
     depth: u32,
+    legend: bool,
 ) -> (Vec<u8>, u32) {
     let mut rgb = frame.to_rgb8();
     draw_cells(&mut rgb, camera, cells);
+    if !legend {
+        return (rgb, frame.height);
+    }
     let legend = frame.legend().unwrap_or_else(|| {
         let most = cells.iter().map(|c| c.references).max().unwrap_or(0);
         crate::legend::Legend {

@@ -331,6 +331,68 @@ fn exports_record_how_they_were_made_and_render_again_identically() {
         out.status.success() && info.contains("samples       16"),
         "{info}"
     );
+    // A viewer export's partial mark, overlay and edits are printed too,
+    // not only with --json.
+    let mut record = glint::export::read_record(&first).unwrap();
+    record.settings.partial = true;
+    record.settings.overlay_depth = Some(3);
+    let scene = glint::scene::load(&scene).unwrap();
+    let mut lights = scene.lights.clone();
+    lights[0].color = glint::math::DVec3::new(0.25, 0.5, 0.75);
+    record.settings.edits = Some(glint::export::SceneEdits {
+        lights,
+        materials: scene.materials.clone(),
+    });
+    let edited = dir.join("edited.png");
+    glint::export::save_rgb_png(&edited, 1, 1, &[9, 9, 9], Some(&record)).unwrap();
+    let out = glint().arg("info").arg(&edited).output().unwrap();
+    let info = String::from_utf8_lossy(&out.stdout);
+    for line in [
+        "partial       yes",
+        "overlay       octree cells to depth 3",
+        &format!(
+            "edits         {} lights and {} materials",
+            scene.lights.len(),
+            scene.materials.len()
+        ),
+        "  light 1     position",
+        "colour 0.25 0.5 0.75",
+        &format!("  material `{}`: colour", scene.materials[0].name),
+    ] {
+        assert!(info.contains(line), "missing {line:?} in\n{info}");
+    }
+    // --legend off: the cost view (and the overlay) at exactly the render's
+    // size, recorded, so --from-png makes the same file again.
+    for overlay in [&[][..], &["--overlay", "octree"][..]] {
+        let out = glint()
+            .args([
+                "render",
+                common::repo_path("scenes/glass.toml").to_str().unwrap(),
+                "-o",
+            ])
+            .arg(&first)
+            .args([
+                "--width", "40", "--height", "30", "--view", "cost", "--legend", "off",
+            ])
+            .args(overlay)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert_eq!(
+            image::image_dimensions(&first).unwrap(),
+            (40, 30),
+            "{overlay:?}"
+        );
+        assert!(String::from_utf8_lossy(&out.stderr).contains("(40x30,"));
+        assert!(!glint::export::read_record(&first).unwrap().settings.legend);
+        let (n, _) = common::rerender_from_png(&first, &again);
+        assert_eq!(n, 0);
+        assert_eq!(image::image_dimensions(&again).unwrap(), (40, 30));
+    }
     let plain = dir.join("plain.png");
     image::RgbImage::new(4, 4).save(&plain).unwrap();
     for args in [vec!["info"], vec!["render", "-o", "x.png", "--from-png"]] {

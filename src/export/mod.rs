@@ -75,14 +75,22 @@ pub fn save_frame(
     record: &mut RenderRecord,
     overlay: Option<OverlayRequest>,
 ) -> Result<(), ExportError> {
+    let legend = record.settings.legend;
     match overlay {
         Some(o) => {
             record.settings.overlay_depth = Some(o.depth);
             let cells = o.octree.cells(o.depth);
-            let (rgb, height) = crate::overlay::annotate(frame, o.camera, &cells, o.depth);
+            let (rgb, height) = crate::overlay::annotate(frame, o.camera, &cells, o.depth, legend);
             save_rgb_png(path, frame.width, height, &rgb, Some(record))
         }
-        None => save_png(frame, path, Some(record)),
+        None if legend => save_png(frame, path, Some(record)),
+        None => save_rgb_png(
+            path,
+            frame.width,
+            frame.height,
+            &frame.to_rgb8(),
+            Some(record),
+        ),
     }
 }
 
@@ -96,6 +104,8 @@ pub struct Restored {
     pub settings: RenderSettings,
     pub camera: CameraSpec,
     pub overlay_depth: Option<u32>,
+    /// Whether the legend strip is drawn (diagnostic views, the overlay).
+    pub legend: bool,
     /// Notes for the user: another glint version, a partial export.
     pub notes: Vec<String>,
 }
@@ -125,6 +135,7 @@ pub fn restore(png: &Path) -> Result<Restored, ExportError> {
         settings: record.settings.render,
         camera: record.settings.camera.into(),
         overlay_depth: record.settings.overlay_depth,
+        legend: record.settings.legend,
         notes,
     })
 }

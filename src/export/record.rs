@@ -53,6 +53,19 @@ pub struct RecordedSettings {
     /// pixels are part old, part new, and a re-render gives the whole pass.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub partial: bool,
+    /// Whether diagnostic views and the overlay have their legend strip
+    /// under the image (`glint render --legend off` leaves it out). Absent
+    /// in records from before the flag: they all have it.
+    #[serde(default = "legend_default", skip_serializing_if = "is_true")]
+    pub legend: bool,
+}
+
+fn legend_default() -> bool {
+    true
+}
+
+fn is_true(b: &bool) -> bool {
+    *b
 }
 
 /// Lights and materials that replace a scene file's own.
@@ -113,6 +126,7 @@ impl RenderRecord {
                 overlay_depth: None,
                 edits: None,
                 partial: false,
+                legend: true,
             },
         }
     }

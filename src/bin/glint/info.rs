@@ -71,10 +71,51 @@ fn write_info(
         s.octree_params.max_duplication,
         s.octree_params.memory_budget_mib
     )?;
+    if let Some(depth) = s.overlay_depth {
+        writeln!(out, "overlay       octree cells to depth {depth}")?;
+    }
+    if s.partial {
+        writeln!(
+            out,
+            "partial       yes: exported while a pass was still sweeping in (part old, part new pixels); a re-render gives the whole pass"
+        )?;
+    }
     writeln!(out, "camera eye    {}", v3(s.camera.eye))?;
     writeln!(out, "camera lookat {}", v3(s.camera.lookat))?;
     writeln!(out, "camera up     {}", v3(s.camera.up))?;
     writeln!(out, "camera fov    {}", s.camera.fov)?;
+    if let Some(e) = &s.edits {
+        let c = |c: glint::math::DVec3| format!("{} {} {}", c.x, c.y, c.z);
+        writeln!(
+            out,
+            "edits         {} lights and {} materials as the viewer had them, in place of the scene file's",
+            e.lights.len(),
+            e.materials.len()
+        )?;
+        for (i, l) in e.lights.iter().enumerate() {
+            writeln!(
+                out,
+                "  light {}     position {}, colour {}",
+                i + 1,
+                c(l.position),
+                c(l.color)
+            )?;
+        }
+        for m in &e.materials {
+            writeln!(
+                out,
+                "  material `{}`: colour {}, kd {}, ks {}, shininess {}, reflectivity {}, transparency {}, ior {}",
+                m.name,
+                c(m.color),
+                m.kd,
+                m.ks,
+                m.shininess,
+                m.reflectivity,
+                m.transparency,
+                m.ior
+            )?;
+        }
+    }
     writeln!(
         out,
         "scene text    {} bytes, {} lines{}",

@@ -88,6 +88,12 @@ pub struct RenderArgs {
     /// as one box at this level). Default 4, or the recorded one with --from-png.
     #[arg(long)]
     pub overlay_depth: Option<u32>,
+    /// The legend strip under diagnostic views (cost, cost-steps, aa-need,
+    /// depth) and the octree overlay: on (the default, or the recorded
+    /// choice with --from-png) or off, for an image exactly the render's
+    /// size.
+    #[arg(long, value_enum)]
+    pub legend: Option<crate::common::Switch>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -191,6 +197,7 @@ struct Prepared {
     camera: CameraSpec,
     octree: Octree,
     overlay_depth: Option<u32>,
+    legend: bool,
     threads: usize,
     pool: rayon::ThreadPool,
     load_s: f64,
@@ -233,6 +240,7 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
     }
     let load_start = Instant::now();
     let mut overlay_depth = args.overlay.map(|_| args.overlay_depth.unwrap_or(4));
+    let mut legend = true;
     let (mut scene, scene_name, mut settings, camera) = match (&args.from_png, &args.scene) {
         (Some(png), _) => {
             let restored = glint::export::restore(png)
@@ -244,6 +252,7 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
                 .overlay_depth
                 .map(|d| args.overlay_depth.unwrap_or(d))
                 .or(overlay_depth);
+            legend = restored.legend;
             (
                 restored.scene,
                 restored.scene_path,
@@ -260,6 +269,9 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
         (None, None) => anyhow::bail!("give a scene file or --from-png"),
     };
     let load_s = load_start.elapsed().as_secs_f64();
+    if let Some(switch) = args.legend {
+        legend = switch.is_on();
+    }
     overrides(args).apply(&mut settings, &mut scene.octree_params);
 
     let pool = thread_pool(args.threads)?;
@@ -286,6 +298,7 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
         camera,
         octree,
         overlay_depth,
+        legend,
         threads,
         pool,
         load_s,
@@ -360,6 +373,7 @@ impl PassWatch for ProgressBar<'_> {
 fn save(job: &Prepared, frame: &glint::frame::Frame, output: &std::path::Path) -> Result<()> {
     let s = &job.settings;
     let mut record = glint::export::RenderRecord::new(&job.scene, &job.scene_name, &job.camera, *s);
+    record.settings.legend = job.legend;
     let camera = glint::camera::Camera::new(&job.camera, s.width, s.height)?;
     let overlay = job
         .overlay_depth
