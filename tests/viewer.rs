@@ -471,7 +471,7 @@ fn a_budget_preview_drops_what_it_says() {
     let (mut job, _, _) = job("scenes/glass.toml", 96, 72, AntiAliasing::Full);
     let preview = glint::viewer::worker::Preview {
         divisor: 2,
-        reflections: false,
+        reflections: glint::viewer::worker::Reflections::Off,
         shadows: false,
     };
     job.preview = Some(preview);
@@ -490,6 +490,37 @@ fn a_budget_preview_drops_what_it_says() {
     assert_eq!(
         (r.rays.shadow, r.rays.reflection, r.rays.refraction),
         (0, 0, 0)
+    );
+
+    // One bounce: the picture of a 1-sample render at depth 2 (glass keeps
+    // its refraction, a black sphere it is not).
+    let one = glint::viewer::worker::Preview {
+        reflections: glint::viewer::worker::Reflections::OneBounce,
+        shadows: true,
+        ..preview
+    };
+    let (mut deep, scene, octree) = crate::job("scenes/glass.toml", 96, 72, AntiAliasing::Full);
+    deep.preview = Some(one);
+    let generation = worker.submit(deep);
+    assert!(worker.wait_finished(generation, WAIT));
+    let mut settings = scene.render_settings();
+    (settings.width, settings.height, settings.max_depth) = (48, 36, 2);
+    settings.set_anti_aliasing(AntiAliasing::Off);
+    let (frame, counts) = Renderer::new(&scene, &octree, settings)
+        .unwrap()
+        .render(false, None);
+    assert!(counts.rays.refraction > 0, "the scene has glass");
+    let r = worker
+        .history()
+        .into_iter()
+        .rfind(|r| r.generation == generation)
+        .unwrap();
+    assert_eq!(r.kind, PassKind::Preview(one));
+    assert_eq!(r.rays, counts.rays);
+    let shown: Vec<u8> = worker.with_buffer(|b| rgba_to_rgb(&b.rgba));
+    assert!(
+        shown == frame.to_rgb8(),
+        "the preview is the depth-2 render"
     );
 }
 
@@ -653,4 +684,31 @@ fn the_built_in_scene_is_saved_as_a_new_file_with_its_mesh() {
     assert_eq!(copy.shapes, builtin.shapes);
     assert_eq!(copy.materials, builtin.materials);
     assert!(dir.path().join("bunny.obj").is_file());
+}
+
+/// A scene opened by a relative name is recorded in exports by its
+/// absolute path, so `--from-png` works from any folder.
+#[test]
+fn exports_record_the_scene_by_its_absolute_path() {
+    let relative = std::path::PathBuf::from("scenes/sphere.toml");
+    assert!(relative.is_file(), "tests run from the repository root");
+    let app = GlintApp::new(
+        SceneSource::File(relative.clone()),
+        ViewerOptions::default(),
+        || {},
+    )
+    .unwrap();
+    let mut h = harness(app);
+    h.state_mut().settings_mut().width = 32;
+    h.state_mut().settings_mut().height = 24;
+    h.run_steps(2);
+    settle(&mut h);
+    let tmp = common::temp_dir();
+    let png = tmp.path().join("x.png");
+    h.state().export_to(&png).unwrap();
+    let record = glint::export::read_record(&png).unwrap();
+    assert_eq!(
+        std::path::PathBuf::from(&record.scene_path),
+        std::fs::canonicalize(&relative).unwrap()
+    );
 }

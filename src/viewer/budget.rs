@@ -1,12 +1,13 @@
 //! The frame budget while the user drags: which preview (resolution,
 //! reflections, shadows) fits the time, estimated from the passes so far.
 
-use super::worker::{PassKind, PassRecord, Preview};
+use super::worker::{PassKind, PassRecord, Preview, Reflections};
 use crate::settings::RenderSettings;
 
 /// The preview to render while the user drags: the best image whose estimated time fits the frame budget. Candidates in order
 /// of preference: full, 1/2, 1/4, 1/8 resolution, each first complete,
-/// then without reflections, then without shadows too. Estimates come
+/// then with one bounce of reflection and refraction (glass and mirrors
+/// keep their look), then without reflections, then without shadows too. Estimates come
 /// from this scene's last full 1-sample pass (its time per pixel, and
 /// its rays by kind for what dropping reflections or shadows saves),
 /// corrected by how far the last preview's estimate was off.
@@ -17,7 +18,7 @@ pub fn choose_preview(
 ) -> Option<(Preview, f64)> {
     let fallback = Preview {
         divisor: 4,
-        reflections: true,
+        reflections: Reflections::All,
         shadows: true,
     };
     let Some(base) = history
@@ -41,7 +42,13 @@ pub fn choose_preview(
         .unwrap_or(1.0);
     let budget = budget_ms / 1000.0;
     let candidates = [1u32, 2, 4, 8].into_iter().flat_map(|divisor| {
-        [(true, true), (false, true), (false, false)].map(|(reflections, shadows)| Preview {
+        [
+            (Reflections::All, true),
+            (Reflections::OneBounce, true),
+            (Reflections::Off, true),
+            (Reflections::Off, false),
+        ]
+        .map(|(reflections, shadows)| Preview {
             divisor,
             reflections,
             shadows,
@@ -60,8 +67,10 @@ pub fn choose_preview(
 
 /// Estimated seconds of `preview` at the current settings, from the full
 /// 1-sample pass `base`: time per pixel times the pixels, times the share
-/// of its rays the preview still casts (dropping reflections drops the
-/// secondary rays and the shadow rays from their hits).
+/// of its rays the preview still casts. The model: every hit (an eye ray's
+/// or a secondary ray's) spawns on average the same number of secondary
+/// and of shadow rays, so one bounce keeps the secondary rays of eye-ray
+/// hits, and dropping reflections keeps only the eye-ray hits' shadow rays.
 fn estimate_preview(base: &PassRecord, preview: &Preview, settings: &RenderSettings) -> f64 {
     let per_pixel = base.seconds / (base.width as f64 * base.height as f64).max(1.0);
     let d = preview.divisor as f64;
@@ -70,18 +79,25 @@ fn estimate_preview(base: &PassRecord, preview: &Preview, settings: &RenderSetti
     let total = r.total().max(1) as f64;
     let secondary = (r.reflection + r.refraction) as f64;
     let hits = r.primary_hits as f64;
-    let mut shadow = r.shadow as f64;
-    let mut rays = total;
-    if !preview.reflections {
-        rays -= secondary;
-        // Shadow rays come from primary and secondary hits alike.
-        let kept = shadow * hits / (hits + secondary).max(1.0);
-        rays -= shadow - kept;
-        shadow = kept;
-    }
-    if !preview.shadows {
-        rays -= shadow;
-    }
+    // Hits that spawn rays: the eye rays' and (at most) every secondary ray's.
+    let all_hits = (hits + secondary).max(1.0);
+    let shadow_per_hit = r.shadow as f64 / all_hits;
+    let kept_secondary = match preview.reflections {
+        Reflections::All => secondary,
+        Reflections::OneBounce if settings.max_depth <= 2 => secondary,
+        Reflections::OneBounce => secondary * hits / all_hits,
+        Reflections::Off => 0.0,
+    };
+    let shadow = if preview.shadows {
+        if kept_secondary == secondary {
+            r.shadow as f64
+        } else {
+            shadow_per_hit * (hits + kept_secondary)
+        }
+    } else {
+        0.0
+    };
+    let rays = r.primary as f64 + kept_secondary + shadow;
     per_pixel * pixels * (rays / total).max(0.05)
 }
 
@@ -143,21 +159,23 @@ mod tests {
         let history = [base()];
         let choose = |ms| choose_preview(&history, &settings(), ms).map(|(p, _)| p);
         // The full 1-sample pass took 400 ms.
-        assert_eq!(choose(500.0), Some(p(1, true, true)));
+        assert_eq!(choose(500.0), Some(p(1, Reflections::All, true)));
         // 1/2 resolution: 100 ms; without reflections 100 * 260/380 = 68 ms.
-        assert_eq!(choose(100.0), Some(p(2, true, true)));
-        assert_eq!(choose(70.0), Some(p(2, false, true)));
+        assert_eq!(choose(100.0), Some(p(2, Reflections::All, true)));
+        // One bounce at 1/2: 100 * 340/380 = 89 ms (see the estimates test).
+        assert_eq!(choose(90.0), Some(p(2, Reflections::OneBounce, true)));
+        assert_eq!(choose(70.0), Some(p(2, Reflections::Off, true)));
         // Resolution goes before effects: 1/2 with neither reflections nor
         // shadows (100 * 100/380 = 26 ms) before 1/4 (25 ms).
-        assert_eq!(choose(33.0), Some(p(2, false, false)));
+        assert_eq!(choose(33.0), Some(p(2, Reflections::Off, false)));
         // 1/4 without reflections: 25 * 260/380 = 17 ms.
-        assert_eq!(choose(20.0), Some(p(4, false, true)));
+        assert_eq!(choose(20.0), Some(p(4, Reflections::Off, true)));
         // Nothing fits: the cheapest candidate.
-        assert_eq!(choose(0.001), Some(p(8, false, false)));
+        assert_eq!(choose(0.001), Some(p(8, Reflections::Off, false)));
         // No full pass yet: a quarter-resolution guess.
         assert_eq!(
             choose_preview(&[], &settings(), 33.0).map(|(p, _)| p),
-            Some(p(4, true, true))
+            Some(p(4, Reflections::All, true))
         );
     }
 
@@ -169,7 +187,7 @@ mod tests {
         let mut slow = base();
         slow.kind = PassKind::Preview(Preview {
             divisor: 4,
-            reflections: true,
+            reflections: Reflections::All,
             shadows: true,
         });
         slow.seconds = 0.1;
@@ -180,7 +198,7 @@ mod tests {
             chosen,
             Preview {
                 divisor: 4,
-                reflections: false,
+                reflections: Reflections::Off,
                 shadows: false
             }
         );
@@ -198,15 +216,27 @@ mod tests {
             reflections,
             shadows,
         };
-        let full = estimate_preview(&base(), &p(1, true, true), &settings);
+        let full = estimate_preview(&base(), &p(1, Reflections::All, true), &settings);
         assert!((full - 0.4).abs() < 1e-12, "the base pass itself");
-        let half = estimate_preview(&base(), &p(2, true, true), &settings);
+        let half = estimate_preview(&base(), &p(2, Reflections::All, true), &settings);
         assert!((half - 0.1).abs() < 1e-12, "a quarter of the pixels");
         // Without reflections: 100 eye rays and the 240 * 80/120 = 160
         // shadow rays of eye-ray hits, of 380 rays.
-        let flat = estimate_preview(&base(), &p(1, false, true), &settings);
+        // One bounce: of the 40 secondary rays, those of eye-ray hits,
+        // 40 * 80/120; shadow rays 2 per hit (240 over 120 hits) of the
+        // 80 + 26.7 hits left: 100 + 26.7 + 213.3 = 340 of 380 rays.
+        let one = estimate_preview(&base(), &p(1, Reflections::OneBounce, true), &settings);
+        assert!((one - 0.4 * 340.0 / 380.0).abs() < 1e-12, "{one}");
+        // With the scene's depth at 2, one bounce is all of them.
+        let shallow = RenderSettings {
+            max_depth: 2,
+            ..settings
+        };
+        let one = estimate_preview(&base(), &p(1, Reflections::OneBounce, true), &shallow);
+        assert!((one - 0.4).abs() < 1e-12, "{one}");
+        let flat = estimate_preview(&base(), &p(1, Reflections::Off, true), &settings);
         assert!((flat - 0.4 * 260.0 / 380.0).abs() < 1e-12, "{flat}");
-        let bare = estimate_preview(&base(), &p(1, false, false), &settings);
+        let bare = estimate_preview(&base(), &p(1, Reflections::Off, false), &settings);
         assert!((bare - 0.4 * 100.0 / 380.0).abs() < 1e-12, "{bare}");
     }
 }

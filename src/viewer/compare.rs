@@ -336,7 +336,7 @@ mod tests {
         };
         let preview = PassKind::Preview(super::super::worker::Preview {
             divisor: 2,
-            reflections: true,
+            reflections: super::super::worker::Reflections::All,
             shadows: true,
         });
         let history = [

@@ -54,7 +54,7 @@ pub fn export_to(
     };
     let mut record = RenderRecord::new(
         &shown.scene,
-        &source.display_name(),
+        &source.record_name(),
         &shown.camera,
         shown.settings,
     );

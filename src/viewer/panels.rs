@@ -230,7 +230,7 @@ fn render_settings_ui(edit: &mut EditState, ui: &mut egui::Ui) {
             )
             .on_hover_text(
                 "while you drag, glint renders the best preview it estimates fits this time: \
-                 full resolution, then 1/2, 1/4, 1/8, each with and without reflections and shadows",
+                 full resolution, then 1/2, 1/4, 1/8, each complete, then with one bounce of reflection, then without reflections, then without shadows too",
             );
         });
     ui.horizontal(|ui| {

@@ -71,9 +71,21 @@ impl PassKind {
 pub struct Preview {
     /// 1/`divisor` of the resolution on each axis.
     pub divisor: u32,
-    /// Reflection and refraction rays (off: the eye ray only).
-    pub reflections: bool,
+    /// How deep reflection and refraction rays go.
+    pub reflections: Reflections,
     pub shadows: bool,
+}
+
+/// Reflection and refraction in a preview.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Reflections {
+    /// To the scene's depth.
+    All,
+    /// One bounce: the eye ray's reflection and refraction rays, not
+    /// theirs (glass and mirrors keep their look, deeper paths go).
+    OneBounce,
+    /// None: the eye ray only.
+    Off,
 }
 
 impl Preview {
@@ -84,8 +96,10 @@ impl Preview {
         } else {
             format!("1/{}", self.divisor)
         };
-        if !self.reflections {
-            s.push_str(", no reflections");
+        match self.reflections {
+            Reflections::All => {}
+            Reflections::OneBounce => s.push_str(", one bounce"),
+            Reflections::Off => s.push_str(", no reflections"),
         }
         if !self.shadows {
             s.push_str(", no shadows");
@@ -348,8 +362,10 @@ fn render_job(shared: &Shared, generation: u64, job: &Job) {
         settings.set_anti_aliasing(crate::settings::AntiAliasing::Off);
         settings.width = (settings.width / p.divisor).max(1);
         settings.height = (settings.height / p.divisor).max(1);
-        if !p.reflections {
-            settings.max_depth = 1;
+        match p.reflections {
+            Reflections::All => {}
+            Reflections::OneBounce => settings.max_depth = settings.max_depth.min(2),
+            Reflections::Off => settings.max_depth = 1,
         }
         settings.shadows = p.shadows;
     }
@@ -569,16 +585,21 @@ mod tests {
     fn passes_describe_what_they_dropped() {
         let preview = Preview {
             divisor: 2,
-            reflections: false,
+            reflections: Reflections::Off,
             shadows: true,
         };
         assert_eq!(
             PassKind::Preview(preview).label(),
             "preview 1/2, no reflections"
         );
+        let one = Preview {
+            reflections: Reflections::OneBounce,
+            ..preview
+        };
+        assert_eq!(one.describe(), "1/2, one bounce");
         let bare = Preview {
             divisor: 1,
-            reflections: false,
+            reflections: Reflections::Off,
             shadows: false,
         };
         assert_eq!(
