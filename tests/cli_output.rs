@@ -342,3 +342,61 @@ fn the_reported_size_is_the_files() {
         stderr(&o)
     );
 }
+
+/// Ctrl+C while the PNG is being written leaves no temporary file behind
+/// (and no output): the write is large enough to be caught in the act.
+#[test]
+fn an_interrupted_write_leaves_no_temporary_file() {
+    let tmp = common::temp_dir();
+    let out = tmp.path().join("big.png");
+    let temporaries = || -> Vec<String> {
+        std::fs::read_dir(tmp.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.starts_with(".glint-"))
+            .collect()
+    };
+    // A plain scene at 1 sample renders quickly; 24 million pixels take a
+    // while to encode.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_glint"))
+        .args([
+            "render",
+            &scene(),
+            "--width",
+            "6000",
+            "--height",
+            "4000",
+            "--samples",
+            "1",
+            "-q",
+            "-o",
+        ])
+        .arg(&out)
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    let mut seen = false;
+    while start.elapsed() < std::time::Duration::from_secs(120) {
+        if !temporaries().is_empty() {
+            seen = true;
+            break;
+        }
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    assert!(
+        seen,
+        "the write was not caught: the test needs a larger image"
+    );
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130), "{status:?}");
+    assert_eq!(temporaries(), Vec::<String>::new());
+    assert!(!out.exists(), "no half-written output");
+}

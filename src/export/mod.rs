@@ -20,7 +20,9 @@ mod record;
 use std::path::Path;
 
 pub use error::ExportError;
-pub use output::{OutputTarget, check_output, save_rgb_png, write_file_atomically};
+pub use output::{
+    OutputTarget, check_output, remove_unfinished_outputs, save_rgb_png, write_file_atomically,
+};
 pub use png_file::{read_record, read_record_bytes};
 pub use record::{
     KEY_SCENE, KEY_SCENE_PATH, KEY_SCENE_SHA256, KEY_SETTINGS, KEY_VERSION, MAX_SCENE_TEXT,

@@ -3,6 +3,7 @@
 //! (following symbolic links to their target).
 
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 use super::error::ExportError;
 use super::png_file::write_png;
@@ -94,6 +95,38 @@ pub fn check_output(path: &Path, input: Option<&Path>) -> Result<OutputTarget, E
         })?;
     }
     Ok(target)
+}
+
+/// Temporary files being written: an interrupted process (Ctrl+C runs no
+/// destructors) removes them with [`remove_unfinished_outputs`].
+static UNFINISHED: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// Keeps a temporary file's name in [`UNFINISHED`] while it is written.
+struct Unfinished(PathBuf);
+
+impl Unfinished {
+    fn register(path: &Path) -> Self {
+        let mut list = UNFINISHED.lock().unwrap_or_else(|e| e.into_inner());
+        list.push(path.to_owned());
+        Unfinished(path.to_owned())
+    }
+}
+
+impl Drop for Unfinished {
+    fn drop(&mut self) {
+        let mut list = UNFINISHED.lock().unwrap_or_else(|e| e.into_inner());
+        list.retain(|p| *p != self.0);
+    }
+}
+
+/// Removes the temporary files of outputs still being written: for a
+/// signal handler, before the process exits without running destructors.
+/// Returns how many it removed.
+pub fn remove_unfinished_outputs() -> usize {
+    let list = UNFINISHED.lock().unwrap_or_else(|e| e.into_inner());
+    list.iter()
+        .filter(|p| std::fs::remove_file(p).is_ok())
+        .count()
 }
 
 /// The folder a file named `file` goes in (`.` for a bare name).
@@ -199,6 +232,7 @@ pub fn save_rgb_png(
             // usual 0666 less the umask (tempfile's own default is 0600).
             let tmp =
                 temporary_with(&dir, kept_permissions(&target), ".png.tmp").map_err(write_error)?;
+            let _unfinished = Unfinished::register(tmp.path());
             {
                 let mut w = std::io::BufWriter::new(tmp.as_file());
                 write_png(&mut w, path, width, height, rgb, record)?;
@@ -241,6 +275,7 @@ pub fn write_file_atomically(path: &Path, bytes: &[u8]) -> Result<(), ExportErro
     };
     let tmp = temporary_with(&folder_of(&target), kept_permissions(&target), ".tmp")
         .map_err(write_error)?;
+    let _unfinished = Unfinished::register(tmp.path());
     {
         use std::io::Write;
         let mut file = tmp.as_file();
@@ -251,4 +286,38 @@ pub fn write_file_atomically(path: &Path, bytes: &[u8]) -> Result<(), ExportErro
     tmp.persist(&target)
         .map_err(|e| write_error(without_path(&e.error)))?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn listed(path: &Path) -> bool {
+        let list = UNFINISHED.lock().unwrap_or_else(|e| e.into_inner());
+        list.iter().any(|p| p == path)
+    }
+
+    // Removal itself is `tests/cli_output.rs`'s: calling it here would
+    // remove other tests' files being written in parallel.
+    #[test]
+    fn temporary_files_are_listed_while_written_and_forgotten_after() {
+        let dir = tempfile::tempdir().unwrap();
+        let tmp = temporary_in(dir.path()).unwrap();
+        let guard = Unfinished::register(tmp.path());
+        assert!(listed(tmp.path()));
+        drop(guard);
+        assert!(!listed(tmp.path()));
+        let done = dir.path().join("done.png");
+        write_file_atomically(&done, b"png").unwrap();
+        let left: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(std::fs::read(&done).unwrap(), b"png");
+        assert_eq!(
+            left.len(),
+            2,
+            "the file and the first temporary only: {left:?}"
+        );
+    }
 }

@@ -38,6 +38,14 @@ enum Command {
 }
 
 fn main() -> std::process::ExitCode {
+    // Ctrl+C (or SIGTERM, SIGHUP) still ends glint at once, but first
+    // removes the hidden temporary file of an output being written, which
+    // the signal would otherwise leave behind. Without a handler (an
+    // unusual platform) the signal's default stands.
+    let _ = ctrlc::set_handler(|| {
+        glint::export::remove_unfinished_outputs();
+        std::process::exit(130);
+    });
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Render(args)) => render_cmd::run(&args),
