@@ -712,3 +712,31 @@ fn exports_record_the_scene_by_its_absolute_path() {
         std::fs::canonicalize(&relative).unwrap()
     );
 }
+
+/// The image is scaled by a whole number of screen pixels per image pixel
+/// (even, crisp blocks), or to fit at any scale, or 1:1.
+#[test]
+fn the_image_is_magnified_by_whole_pixels_to_fit_or_one_to_one() {
+    use glint::viewer::state::Magnification;
+    let mut h = harness(small_app());
+    let ppp = h.ctx.pixels_per_point();
+    let whole = h.state().image_rect().unwrap();
+    let block = whole.width() * ppp / 64.0;
+    assert!(block >= 2.0 && block == block.round(), "{block}");
+    assert_eq!(whole.height() * ppp / 48.0, block);
+    assert_eq!(
+        whole.min.x * ppp,
+        (whole.min.x * ppp).round(),
+        "on the pixel grid"
+    );
+
+    h.state_mut().set_magnification(Magnification::Fit);
+    h.run_steps(2);
+    let fit = h.state().image_rect().unwrap();
+    assert!(fit.width() >= whole.width() && fit.width() < whole.width() * (block + 1.0) / block);
+
+    h.state_mut().set_magnification(Magnification::Actual);
+    h.run_steps(2);
+    let actual = h.state().image_rect().unwrap();
+    assert_eq!((actual.width() * ppp, actual.height() * ppp), (64.0, 48.0));
+}

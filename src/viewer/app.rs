@@ -15,13 +15,21 @@ use super::panels::{Message, RenderInfo};
 use super::pixel::Inspection;
 use super::screenshot::Screenshot;
 pub use super::state::{CompareSetting, SceneSource};
-use super::state::{EditState, Snapshot};
+use super::state::{EditState, Magnification, Snapshot};
 use super::worker::{Job, Preview, Worker};
 use super::{budget, export, input, panels, save, timing};
 use crate::accel::Octree;
 use crate::camera::CameraSpec;
 use crate::scene::Scene;
 use crate::settings::{AntiAliasing, Overrides, RenderSettings};
+
+/// Pixels stay sharp blocks when magnified; a large image shrunk to fit
+/// is filtered rather than losing whole rows.
+const TEXTURE: TextureOptions = TextureOptions {
+    magnification: egui::TextureFilter::Nearest,
+    minification: egui::TextureFilter::Linear,
+    ..TextureOptions::NEAREST
+};
 
 /// Start-up options of the viewer.
 #[derive(Clone, Debug, Default)]
@@ -76,6 +84,8 @@ pub struct GlintApp {
     discarding: Option<Discarding>,
     /// The window title last sent.
     title: String,
+    /// How the image is scaled into its panel.
+    magnification: Magnification,
     // The runtime: the octree of the scene, the render worker and what
     // is on screen.
     octree: Arc<Octree>,
@@ -133,6 +143,7 @@ impl GlintApp {
             saved,
             discarding: None,
             title: String::new(),
+            magnification: Magnification::default(),
             octree: Arc::new(octree),
             build_seconds,
             worker,
@@ -192,6 +203,10 @@ impl GlintApp {
     /// Mutable access to lights and materials; marks the image stale.
     pub fn scene_mut(&mut self) -> &mut Scene {
         self.edit.scene_mut()
+    }
+
+    pub fn set_magnification(&mut self, m: Magnification) {
+        self.magnification = m;
     }
 
     pub fn camera_mut(&mut self) -> &mut CameraSpec {
@@ -300,7 +315,10 @@ impl GlintApp {
             can_undo: self.undoer.has_undo(&snapshot),
             can_redo: self.undoer.has_redo(&snapshot),
         };
-        egui::Panel::top("menu").show(ui, |ui| commands.extend(panels::menu_ui(&menu, ui)));
+        let magnification = &mut self.magnification;
+        egui::Panel::top("menu").show(ui, |ui| {
+            commands.extend(panels::menu_ui(&menu, magnification, ui))
+        });
         let info = RenderInfo {
             worker: &self.worker,
             octree: &self.octree,
@@ -343,15 +361,20 @@ impl GlintApp {
     fn image_ui(&mut self, ui: &mut egui::Ui) -> Vec<Command> {
         let (width, height) = (self.edit.settings.width, self.edit.settings.height);
         let available = ui.available_size();
-        let aspect = width as f32 / height.max(1) as f32;
-        // Fit the image into the panel (display-only: never restarts a render).
-        let mut size = egui::vec2(available.x, available.x / aspect);
-        if size.y > available.y {
-            size = egui::vec2(available.y * aspect, available.y);
-        }
+        // Scale the image into the panel (display-only: never restarts a render).
+        let pixels_per_point = ui.ctx().pixels_per_point();
+        let scale = self
+            .magnification
+            .scale((width, height), available, pixels_per_point);
+        let size = egui::vec2(width as f32 * scale, height as f32 * scale);
         let (rect, response) = ui.allocate_exact_size(available, Sense::click_and_drag());
-        let image_rect = egui::Rect::from_center_size(rect.center(), size);
+        // On the screen's pixel grid, so whole-pixel blocks stay even.
+        let snap = |x: f32| (x * pixels_per_point).round() / pixels_per_point;
+        let min = rect.center() - size / 2.0;
+        let image_rect = egui::Rect::from_min_size(egui::pos2(snap(min.x), snap(min.y)), size);
         self.image_rect = Some(image_rect);
+        // 1:1 may be larger than the panel: cut it at the panel's edges.
+        ui.set_clip_rect(rect.intersect(ui.clip_rect()));
         let live = self.texture.clone();
         let compared = self
             .inspect
@@ -491,11 +514,8 @@ impl GlintApp {
         if let Some(Some((version, image))) = update {
             self.shown_version = version;
             match &mut self.texture {
-                Some(t) => t.set(image, TextureOptions::NEAREST),
-                None => {
-                    self.texture =
-                        Some(ctx.load_texture("glint-render", image, TextureOptions::NEAREST))
-                }
+                Some(t) => t.set(image, TEXTURE),
+                None => self.texture = Some(ctx.load_texture("glint-render", image, TEXTURE)),
             }
         }
     }

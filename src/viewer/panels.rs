@@ -39,7 +39,11 @@ pub struct MenuState<'a> {
     pub can_redo: bool,
 }
 
-pub fn menu_ui(state: &MenuState, ui: &mut egui::Ui) -> Vec<Command> {
+pub fn menu_ui(
+    state: &MenuState,
+    magnification: &mut super::state::Magnification,
+    ui: &mut egui::Ui,
+) -> Vec<Command> {
     let mut commands = Vec::new();
     let mut item = |ui: &mut egui::Ui, enabled: bool, label: &str, command: Command| {
         if ui.add_enabled(enabled, egui::Button::new(label)).clicked() {
@@ -64,6 +68,10 @@ pub fn menu_ui(state: &MenuState, ui: &mut egui::Ui) -> Vec<Command> {
         });
         ui.menu_button("View", |ui| {
             item(ui, true, "Reset camera  (R)", Command::ResetCamera);
+            ui.separator();
+            for m in super::state::Magnification::ALL {
+                ui.radio_value(magnification, m, m.name());
+            }
         });
         ui.separator();
         let name = if state.unsaved {

@@ -17,6 +17,55 @@ pub enum CompareSetting {
     AntiAliasing,
 }
 
+/// How the image is scaled into its panel (display only: never a render).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Magnification {
+    /// The largest whole number of screen pixels per image pixel that
+    /// fits, so every pixel is an even, crisp block (fit when the image is
+    /// larger than the panel).
+    #[default]
+    WholePixels,
+    /// As large as fits, at any scale (blocks of uneven size).
+    Fit,
+    /// One image pixel per screen pixel, centred, cut at the panel's edges.
+    Actual,
+}
+
+impl Magnification {
+    pub const ALL: [Magnification; 3] = [
+        Magnification::WholePixels,
+        Magnification::Fit,
+        Magnification::Actual,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Magnification::WholePixels => "Fit, whole pixels",
+            Magnification::Fit => "Fit",
+            Magnification::Actual => "1:1",
+        }
+    }
+
+    /// Points per image pixel for an image `image` pixels in a panel
+    /// `available` points, at `pixels_per_point` screen pixels per point.
+    pub fn scale(self, image: (u32, u32), available: egui::Vec2, pixels_per_point: f32) -> f32 {
+        let (w, h) = (image.0.max(1) as f32, image.1.max(1) as f32);
+        let fit = (available.x / w).min(available.y / h);
+        match self {
+            Magnification::Fit => fit,
+            Magnification::WholePixels => {
+                let screen_pixels = fit * pixels_per_point;
+                if screen_pixels >= 1.0 {
+                    screen_pixels.floor() / pixels_per_point
+                } else {
+                    fit
+                }
+            }
+            Magnification::Actual => 1.0 / pixels_per_point,
+        }
+    }
+}
+
 /// Where the current scene came from.
 #[derive(Clone, Debug, PartialEq)]
 pub enum SceneSource {
