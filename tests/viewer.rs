@@ -740,3 +740,37 @@ fn the_image_is_magnified_by_whole_pixels_to_fit_or_one_to_one() {
     let actual = h.state().image_rect().unwrap();
     assert_eq!((actual.width() * ppp, actual.height() * ppp), (64.0, 48.0));
 }
+
+/// Stop ends a long pass (here brute force on 91,850 triangles) within a
+/// tile per thread and keeps the image as far as it got; the next job
+/// renders as usual.
+#[test]
+fn a_long_pass_can_be_stopped_and_the_next_change_renders_again() {
+    let worker = Worker::spawn(2, || {});
+    let (mut slow, _, _) = job("scenes/bunnies.toml", 96, 72, AntiAliasing::Full);
+    slow.settings.use_octree = false;
+    let generation = worker.submit(slow);
+    let start = std::time::Instant::now();
+    while worker.with_buffer(|b| b.tiles_done) < 1 {
+        assert!(start.elapsed() < WAIT, "no tile finished");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    worker.stop();
+    let (stopped, finished) = worker.with_buffer(|b| (b.stopped, b.finished));
+    assert!(stopped && !finished);
+    // The tiles in flight finish; no new one starts.
+    std::thread::sleep(Duration::from_millis(1500));
+    let started = worker.tiles_started(generation);
+    std::thread::sleep(Duration::from_millis(500));
+    assert_eq!(
+        worker.tiles_started(generation),
+        started,
+        "tiles went on after stop"
+    );
+    assert!(worker.with_buffer(|b| b.stopped && !b.finished && b.generation == generation));
+
+    let (quick, _, _) = job("scenes/sphere.toml", 32, 24, AntiAliasing::Off);
+    let next = worker.submit(quick);
+    assert!(worker.wait_finished(next, WAIT));
+    assert!(!worker.with_buffer(|b| b.stopped));
+}

@@ -326,7 +326,9 @@ impl GlintApp {
             last_preview: self.last_preview,
             message: self.messages.last(),
         };
-        egui::Panel::bottom("status").show(ui, |ui| panels::status_ui(&self.edit, &info, ui));
+        egui::Panel::bottom("status").show(ui, |ui| {
+            commands.extend(panels::status_ui(&self.edit, &info, ui))
+        });
         // Fixed widths: rows appearing (the RMSE, a ray tree) must not
         // widen a panel and shrink the image.
         egui::Panel::left("controls")
@@ -421,6 +423,7 @@ impl GlintApp {
                 Command::Reload => self.reload(),
                 Command::Open => self.open_dialog(),
                 Command::Save => self.save(),
+                Command::StopPass => self.worker.stop(),
                 Command::SaveAs => self.save_as(),
                 Command::Undo => {
                     let now = self.edit.snapshot();

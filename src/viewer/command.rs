@@ -17,6 +17,8 @@ pub enum Command {
     Undo,
     /// Step forward again.
     Redo,
+    /// Stop the pass being rendered, keeping the image as far as it got.
+    StopPass,
     /// Write the frame on screen to a PNG.
     Export,
     /// Back to the scene's camera.

@@ -346,14 +346,30 @@ fn materials_ui(edit: &mut EditState, ui: &mut egui::Ui) {
     }
 }
 
-/// Progress of the pass on screen and the newest message.
-pub fn status_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
+/// Progress of the pass on screen, with the time left and a stop button,
+/// and the newest message.
+pub fn status_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) -> Vec<Command> {
+    let mut commands = Vec::new();
     ui.horizontal(|ui| {
-        let status = info
-            .worker
-            .try_with_buffer(|b| (b.pass, b.tiles_done, b.tiles_total, b.finished));
+        let status = info.worker.try_with_buffer(|b| {
+            (
+                b.pass,
+                b.tiles_done,
+                b.tiles_total,
+                b.finished,
+                b.pass_started.map(|t| t.elapsed().as_secs_f64()),
+                b.stopped,
+            )
+        });
         match status {
-            Some((Some(pass), done, total, finished)) => {
+            Some((Some(pass), done, total, _, _, true)) => {
+                let pct = 100.0 * done as f64 / total.max(1) as f64;
+                ui.label(format!(
+                    "stopped: {} at {pct:.0}% (any change renders again)",
+                    pass.label()
+                ));
+            }
+            Some((Some(pass), done, total, finished, elapsed, false)) => {
                 if finished {
                     ui.label(format!(
                         "done: {} ({}x{})",
@@ -365,6 +381,16 @@ pub fn status_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
                     let pct = 100.0 * done as f64 / total.max(1) as f64;
                     ui.label(format!("rendering {}: {pct:.0}%", pass.label()));
                     ui.add(egui::ProgressBar::new((pct / 100.0) as f32).desired_width(160.0));
+                    if let Some(left) = elapsed.and_then(|e| time_left(e, done, total)) {
+                        ui.label(format!("about {} left", seconds_text(left)));
+                    }
+                    if ui
+                        .button("Stop")
+                        .on_hover_text("stop this pass, keeping the image as far as it got")
+                        .clicked()
+                    {
+                        commands.push(Command::StopPass);
+                    }
                 }
             }
             Some((None, ..)) => {
@@ -384,4 +410,42 @@ pub fn status_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
             ui.label(RichText::new(&m.text).color(color));
         }
     });
+    commands
+}
+
+/// Seconds left of a pass `elapsed` seconds in with `done` of `total`
+/// tiles finished, at the pace so far; none until a few tiles and a
+/// second have passed (earlier guesses jump about).
+pub fn time_left(elapsed: f64, done: u64, total: u64) -> Option<f64> {
+    if done < 4 || elapsed < 1.0 || done >= total {
+        return None;
+    }
+    Some(elapsed * (total - done) as f64 / done as f64)
+}
+
+/// "42 s", "3 min 5 s", "1 h 12 min".
+fn seconds_text(s: f64) -> String {
+    let s = s.round() as u64;
+    match s {
+        0..60 => format!("{s} s"),
+        60..3600 => format!("{} min {} s", s / 60, s % 60),
+        _ => format!("{} h {} min", s / 3600, s / 60 % 60),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn time_left_follows_the_pace_so_far() {
+        // 10 of 40 tiles in 5 s: 30 more at 0.5 s each.
+        assert_eq!(time_left(5.0, 10, 40), Some(15.0));
+        assert_eq!(time_left(0.5, 10, 40), None, "too early to tell");
+        assert_eq!(time_left(5.0, 2, 40), None, "too few tiles");
+        assert_eq!(time_left(5.0, 40, 40), None, "done");
+        assert_eq!(seconds_text(42.4), "42 s");
+        assert_eq!(seconds_text(185.0), "3 min 5 s");
+        assert_eq!(seconds_text(4320.0), "1 h 12 min");
+    }
 }

@@ -72,7 +72,8 @@ fn timing_grid_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
             .rev()
             .find(|r| Some(r.generation) == shown && r.kind == kind)
     };
-    let rendering = info.worker.generation() != shown.unwrap_or(0);
+    let stopped = info.worker.try_with_buffer(|b| b.stopped).unwrap_or(false);
+    let rendering = info.worker.generation() != shown.unwrap_or(0) && !stopped;
     egui::Grid::new("timing-grid")
         .num_columns(2)
         .max_col_width(170.0)
@@ -84,7 +85,13 @@ fn timing_grid_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
                 ui.add(egui::Label::new(value).wrap());
                 ui.end_row();
             };
-            let pending = if rendering { "rendering…" } else { "–" };
+            let pending = if rendering {
+                "rendering…"
+            } else if stopped {
+                "stopped"
+            } else {
+                "–"
+            };
             if let Some(r) = of_shown(PassKind::Corners) {
                 row("SPD corner pass", format!("{:.3} s", r.seconds));
             } else {
@@ -160,16 +167,26 @@ fn timing_grid_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
                 row("rays: reflection", format!("{}", r.rays.reflection));
                 row("rays: refraction", format!("{}", r.rays.refraction));
             }
-            let stats = info.octree.stats();
-            row("octree build", format!("{:.3} s", info.build_seconds));
-            row(
-                "octree nodes",
-                format!("{} ({} leaves)", stats.nodes, stats.leaves),
-            );
-            row(
-                "octree memory",
-                format!("{:.1} KiB", stats.memory_bytes as f64 / 1024.0),
-            );
+            if edit.settings.use_octree {
+                let stats = info.octree.stats();
+                row("octree build", format!("{:.3} s", info.build_seconds));
+                row(
+                    "octree nodes",
+                    format!("{} ({} leaves)", stats.nodes, stats.leaves),
+                );
+                row(
+                    "octree memory",
+                    format!("{:.1} KiB", stats.memory_bytes as f64 / 1024.0),
+                );
+            } else {
+                row(
+                    "octree",
+                    format!(
+                        "off: every ray tests all {} primitives",
+                        edit.scene.shapes.len()
+                    ),
+                );
+            }
             row("shapes", format!("{}", edit.scene.shapes.len()));
         });
     ui.separator();

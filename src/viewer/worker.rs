@@ -150,6 +150,11 @@ pub struct DisplayBuffer {
     pub tiles_total: u64,
     /// True when the last pass of the generation is complete.
     pub finished: bool,
+    /// When the pass on screen started (for the time left).
+    pub pass_started: Option<Instant>,
+    /// The user stopped the pass on screen ([`Worker::stop`]): the image
+    /// stays as far as it got until the next change.
+    pub stopped: bool,
     /// The linear-light frame of the last completed pass (for exact comparisons).
     pub last_frame: Option<Frame>,
     /// What the pass on screen renders: scene, camera and settings (its
@@ -264,6 +269,20 @@ impl Worker {
 
     pub fn generation(&self) -> u64 {
         self.shared.generation.load(Ordering::SeqCst)
+    }
+
+    /// Stops the passes in flight (within a tile per thread), keeping the
+    /// image as far as it got; the next submitted job renders as usual.
+    pub fn stop(&self) {
+        let mut b = self.shared.buffer.lock().unwrap_or_else(|e| e.into_inner());
+        if b.finished {
+            return;
+        }
+        self.shared.generation.fetch_add(1, Ordering::SeqCst);
+        b.stopped = true;
+        b.version += 1;
+        drop(b);
+        (self.shared.repaint)();
     }
 
     /// What went wrong in the worker since the last call, if anything.
@@ -461,6 +480,8 @@ impl PassWatch for Display<'_> {
         b.tiles_done = 0;
         b.tiles_total = pass.tiles;
         b.finished = false;
+        b.pass_started = Some(Instant::now());
+        b.stopped = false;
         b.version += 1;
     }
 
