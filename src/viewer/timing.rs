@@ -206,10 +206,12 @@ fn round_step(x: f64) -> f64 {
         .unwrap_or(10.0 * power)
 }
 
-/// A session-time tick: blank left of 0 (the legend's room), with as many
-/// decimals as the step needs so that neighbouring ticks never read alike.
-fn time_tick_label(value: f64, step: f64) -> String {
-    if value < -0.5 * step {
+/// A session-time tick: blank left of 0 (the legend's room) and within
+/// half a label's width of the right edge (where it would be cut), with as
+/// many decimals as the step needs so that neighbouring ticks never read
+/// alike.
+fn time_tick_label(value: f64, step: f64, right_edge: f64) -> String {
+    if value < -0.5 * step || value > right_edge - 0.25 * step {
         return String::new();
     }
     let decimals = if step >= 1.0 {
@@ -222,41 +224,67 @@ fn time_tick_label(value: f64, step: f64) -> String {
     format!("{value:.decimals$}")
 }
 
-/// Every full pass of the session, one series per octree and anti-aliasing
-/// setting so each toggle shows as a jump between series, on a logarithmic
-/// time axis (a 100 s pass with the octree off must not flatten the rest).
+/// Which series of the plot a pass belongs to: passes of one kind (1 or
+/// 16 samples, SPD corners), octree setting and view are comparable.
+#[derive(Clone, Copy, PartialEq)]
+struct SeriesKey {
+    octree: bool,
+    kind: PassKind,
+    view: ViewMode,
+}
+
+impl SeriesKey {
+    fn of(r: &PassRecord) -> Self {
+        Self {
+            octree: r.octree,
+            kind: r.kind,
+            view: r.view,
+        }
+    }
+
+    /// E.g. "octree on, 16 spp" or "octree off, 1 spp, cost view".
+    fn name(&self) -> String {
+        let kind = match self.kind {
+            PassKind::SixteenSamples => "16 spp",
+            PassKind::Corners => "SPD corners",
+            _ => "1 spp",
+        };
+        let mut name = format!("octree {}, {kind}", if self.octree { "on" } else { "off" });
+        if self.view != ViewMode::Shaded {
+            name += &format!(", {} view", self.view.name());
+        }
+        name
+    }
+}
+
+/// Every full pass of the session, one series per octree setting, pass
+/// kind and view, so each toggle shows as a jump between series, on a
+/// logarithmic time axis (a 100 s pass with the octree off must not
+/// flatten the rest).
 fn pass_plot_ui(history: &[PassRecord], ui: &mut egui::Ui) {
     ui.label("Pass times this session (log scale)");
-    let series = [
-        (
-            true,
-            false,
-            "octree on, 1 spp",
-            Color32::from_rgb(80, 160, 255),
-        ),
-        (
-            false,
-            false,
-            "octree off, 1 spp",
-            Color32::from_rgb(255, 120, 80),
-        ),
-        (
-            true,
-            true,
-            "octree on, 16 spp",
-            Color32::from_rgb(60, 200, 120),
-        ),
-        (
-            false,
-            true,
-            "octree off, 16 spp",
-            Color32::from_rgb(230, 190, 60),
-        ),
+    const COLORS: [Color32; 8] = [
+        Color32::from_rgb(80, 160, 255),
+        Color32::from_rgb(60, 200, 120),
+        Color32::from_rgb(255, 120, 80),
+        Color32::from_rgb(230, 190, 60),
+        Color32::from_rgb(200, 110, 230),
+        Color32::from_rgb(90, 210, 220),
+        Color32::from_rgb(240, 110, 160),
+        Color32::from_rgb(170, 170, 170),
     ];
     let full: Vec<_> = history
         .iter()
         .filter(|r| !matches!(r.kind, PassKind::Preview(_)))
         .collect();
+    // Series in order of first appearance, each keeping its colour.
+    let mut keys: Vec<SeriesKey> = Vec::new();
+    for r in &full {
+        let key = SeriesKey::of(r);
+        if !keys.contains(&key) {
+            keys.push(key);
+        }
+    }
     let log = |s: f64| s.max(1e-4).log10();
     // Whole decades around the data, so the axis always shows at least two
     // labelled ticks; the time axis starts at 0 and reaches past the newest
@@ -279,7 +307,8 @@ fn pass_plot_ui(history: &[PassRecord], ui: &mut egui::Ui) {
         .allow_zoom(false)
         .allow_scroll(false)
         .include_y(lo)
-        .include_y(hi + 0.6)
+        // Room above the data for the legend, a row per series.
+        .include_y(hi + 0.3 * keys.len().max(2) as f64)
         .include_x(-0.35 * newest)
         .include_x(newest * 1.05)
         .x_axis_label("session time (s)")
@@ -299,20 +328,18 @@ fn pass_plot_ui(history: &[PassRecord], ui: &mut egui::Ui) {
                 format!("{seconds:.0} s")
             }
         })
-        .x_axis_formatter(|mark, _| time_tick_label(mark.value, mark.step_size))
+        .x_axis_formatter(|mark, range| time_tick_label(mark.value, mark.step_size, *range.end()))
         .show(ui, |plot| {
-            for (octree, sixteen, name, color) in series {
+            for (k, key) in keys.iter().enumerate() {
+                let color = COLORS[k % COLORS.len()];
+                let name = key.name();
                 let points: Vec<[f64; 2]> = full
                     .iter()
-                    .filter(|r| {
-                        r.octree == octree && (r.kind == PassKind::SixteenSamples) == sixteen
-                    })
+                    .filter(|r| SeriesKey::of(r) == *key)
                     .map(|r| [r.finished_at, log(r.seconds)])
                     .collect();
-                if !points.is_empty() {
-                    plot.line(Line::new(name, points.clone()).color(color));
-                    plot.points(Points::new(name, points).color(color).radius(3.0));
-                }
+                plot.line(Line::new(name.clone(), points.clone()).color(color));
+                plot.points(Points::new(name, points).color(color).radius(3.0));
             }
         });
 }
@@ -336,12 +363,32 @@ mod tests {
         // A session under a second: steps of 0.5 once printed "0 0 1".
         let labels: Vec<_> = [-0.5, -1e-17, 0.5, 1.0]
             .iter()
-            .map(|&v| time_tick_label(v, 0.5))
+            .map(|&v| time_tick_label(v, 0.5, 10.0))
             .collect();
         assert_eq!(labels, ["", "0.0", "0.5", "1.0"]);
-        assert_eq!(time_tick_label(0.2, 0.1), "0.2");
-        assert_eq!(time_tick_label(0.05, 0.05), "0.05");
-        assert_eq!(time_tick_label(30.0, 10.0), "30");
-        assert_eq!(time_tick_label(-10.0, 10.0), "");
+        assert_eq!(time_tick_label(0.2, 0.1, 10.0), "0.2");
+        assert_eq!(time_tick_label(0.05, 0.05, 10.0), "0.05");
+        assert_eq!(time_tick_label(30.0, 10.0, 100.0), "30");
+        assert_eq!(time_tick_label(-10.0, 10.0, 100.0), "");
+        // A tick at the plot's right edge would be cut in half: blank.
+        assert_eq!(time_tick_label(40.0, 10.0, 41.0), "");
+        assert_eq!(time_tick_label(30.0, 10.0, 41.0), "30");
+    }
+
+    #[test]
+    fn series_say_what_their_passes_are() {
+        let key = |octree, kind, view| SeriesKey { octree, kind, view };
+        assert_eq!(
+            key(true, PassKind::OneSample, ViewMode::Shaded).name(),
+            "octree on, 1 spp"
+        );
+        assert_eq!(
+            key(false, PassKind::SixteenSamples, ViewMode::Cost).name(),
+            "octree off, 16 spp, cost view"
+        );
+        assert_eq!(
+            key(true, PassKind::Corners, ViewMode::Shaded).name(),
+            "octree on, SPD corners"
+        );
     }
 }
