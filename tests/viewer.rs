@@ -774,3 +774,42 @@ fn a_long_pass_can_be_stopped_and_the_next_change_renders_again() {
     assert!(worker.wait_finished(next, WAIT));
     assert!(!worker.with_buffer(|b| b.stopped));
 }
+
+/// An export records the name and text of the scene it rendered, which
+/// belong together: after "Save as" (which renders nothing) the image on
+/// screen is still the old file's, until the next change renders the new.
+#[test]
+fn an_export_after_save_as_records_the_file_its_image_was_rendered_from() {
+    let (dir, path) = scene_in_temp_folder();
+    let app = GlintApp::new(
+        SceneSource::File(path.clone()),
+        ViewerOptions::default(),
+        || {},
+    )
+    .unwrap();
+    let mut h = harness(app);
+    settle(&mut h);
+    let other = dir.path().join("elsewhere");
+    std::fs::create_dir(&other).unwrap();
+    let copy = other.join("copy.toml");
+    h.state_mut().camera_mut().fov = 30.0;
+    h.run_steps(2);
+    settle(&mut h);
+    h.state_mut().save_to(&copy);
+    assert!(!h.state().unsaved());
+    let png = dir.path().join("x.png");
+    let recorded = |h: &Harness<'static, GlintApp>| {
+        h.state().export_to(&png).unwrap();
+        let r = glint::export::read_record(&png).unwrap();
+        (std::path::PathBuf::from(r.scene_path), r.scene_text)
+    };
+    let (name, text) = recorded(&h);
+    assert_eq!(name, std::fs::canonicalize(&path).unwrap());
+    assert_eq!(text, std::fs::read_to_string(&path).unwrap());
+    h.state_mut().camera_mut().fov = 31.0;
+    h.run_steps(2);
+    settle(&mut h);
+    let (name, text) = recorded(&h);
+    assert_eq!(name, std::fs::canonicalize(&copy).unwrap());
+    assert_eq!(text, std::fs::read_to_string(&copy).unwrap());
+}

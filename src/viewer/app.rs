@@ -257,13 +257,7 @@ impl GlintApp {
     /// screen, not the panels' current values; a pass still sweeping in is
     /// written as displayed and recorded as partial.
     pub fn export_to(&self, path: &Path) -> anyhow::Result<()> {
-        export::export_to(
-            path,
-            &self.worker,
-            &self.octree,
-            &self.edit.source,
-            self.inspect.overlay_depth,
-        )
+        export::export_to(path, &self.worker, &self.octree, self.inspect.overlay_depth)
     }
 
     /// Is the final pass of the current job on screen?

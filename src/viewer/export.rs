@@ -36,7 +36,6 @@ pub fn export_to(
     path: &Path,
     worker: &Worker,
     octree: &Octree,
-    source: &SceneSource,
     overlay_depth: Option<u32>,
 ) -> anyhow::Result<()> {
     let (w, h, rgba, frame, shown, finished) = worker.with_buffer(|b| {
@@ -52,12 +51,18 @@ pub fn export_to(
     let Some(shown) = shown.filter(|_| w > 0 && h > 0) else {
         anyhow::bail!("nothing has been rendered yet");
     };
-    let mut record = RenderRecord::new(
-        &shown.scene,
-        &source.record_name(),
-        &shown.camera,
-        shown.settings,
-    );
+    // The rendered scene's own name and text, which belong together (a
+    // save since may have renamed the file in the window), by its absolute
+    // path so that `--from-png` finds it and its meshes from any folder.
+    let scene_name = if shown.scene.name == crate::scene::builtin::NAME {
+        shown.scene.name.clone()
+    } else {
+        let p = Path::new(&shown.scene.name);
+        std::fs::canonicalize(p)
+            .or_else(|_| std::path::absolute(p))
+            .map_or_else(|_| shown.scene.name.clone(), |p| p.display().to_string())
+    };
+    let mut record = RenderRecord::new(&shown.scene, &scene_name, &shown.camera, shown.settings);
     // Lights and materials as rendered (the panels may have edited them).
     record.settings.edits = Some(SceneEdits {
         lights: shown.scene.lights.clone(),

@@ -99,20 +99,6 @@ impl SceneSource {
         }
     }
 
-    /// The scene's name as an exported PNG records it: a file by its
-    /// absolute path, so that `--from-png` finds it and its meshes from any
-    /// folder.
-    pub fn record_name(&self) -> String {
-        match self {
-            SceneSource::BuiltIn => crate::scene::builtin::NAME.to_string(),
-            SceneSource::File(p) => std::fs::canonicalize(p)
-                .or_else(|_| std::path::absolute(p))
-                .unwrap_or_else(|_| p.clone())
-                .display()
-                .to_string(),
-        }
-    }
-
     /// The scene's name as the window shows it.
     pub fn display_name(&self) -> String {
         match self {
