@@ -18,10 +18,19 @@ use glint::viewer::{GlintApp, SceneSource, ViewerOptions};
 
 const WAIT: Duration = Duration::from_secs(60);
 
+/// The viewer on the scene file `path`, at the scene's own settings.
+fn app_at(path: &std::path::Path) -> GlintApp {
+    GlintApp::new(
+        SceneSource::File(path.to_owned()),
+        ViewerOptions::default(),
+        || {},
+    )
+    .unwrap()
+}
+
 /// The viewer on a scene of the repository, rendering at `width` x `height`.
 fn app_for(scene: &str, width: u32, height: u32) -> GlintApp {
-    let source = SceneSource::File(common::repo_path(scene));
-    let mut app = GlintApp::new(source, ViewerOptions::default(), || {}).unwrap();
+    let mut app = app_at(&common::repo_path(scene));
     app.settings_mut().width = width;
     app.settings_mut().height = height;
     app
@@ -589,12 +598,7 @@ fn press(h: &mut Harness<'static, GlintApp>, modifiers: egui::Modifiers, key: eg
 fn edits_undo_redo_save_and_a_reload_that_asks() {
     use egui::{Key, Modifiers};
     let (_dir, path) = scene_in_temp_folder();
-    let app = GlintApp::new(
-        SceneSource::File(path.clone()),
-        ViewerOptions::default(),
-        || {},
-    )
-    .unwrap();
+    let app = app_at(&path);
     let mut h = harness(app);
     assert!(!h.state().unsaved());
     assert!(!h.state().title().starts_with('●'), "{}", h.state().title());
@@ -692,12 +696,7 @@ fn the_built_in_scene_is_saved_as_a_new_file_with_its_mesh() {
 fn exports_record_the_scene_by_its_absolute_path() {
     let relative = std::path::PathBuf::from("scenes/sphere.toml");
     assert!(relative.is_file(), "tests run from the repository root");
-    let app = GlintApp::new(
-        SceneSource::File(relative.clone()),
-        ViewerOptions::default(),
-        || {},
-    )
-    .unwrap();
+    let app = app_at(&relative);
     let mut h = harness(app);
     h.state_mut().settings_mut().width = 32;
     h.state_mut().settings_mut().height = 24;
@@ -781,12 +780,7 @@ fn a_long_pass_can_be_stopped_and_the_next_change_renders_again() {
 #[test]
 fn an_export_after_save_as_records_the_file_its_image_was_rendered_from() {
     let (dir, path) = scene_in_temp_folder();
-    let app = GlintApp::new(
-        SceneSource::File(path.clone()),
-        ViewerOptions::default(),
-        || {},
-    )
-    .unwrap();
+    let app = app_at(&path);
     let mut h = harness(app);
     settle(&mut h);
     let other = dir.path().join("elsewhere");
