@@ -349,6 +349,15 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 let apex = tokens.vec3("cone apex")?;
                 let apex_radius = tokens.number("cone apex radius")?;
                 let m = needs_material(material, &tokens)?;
+                // Like a sphere of radius zero: a segment, with no surface.
+                if base_radius == 0.0 && apex_radius == 0.0 {
+                    return Err(tokens.error_at(
+                        line,
+                        column,
+                        "c",
+                        "cone radii must not both be zero",
+                    ));
+                }
                 let cone = Cone::new(base, base_radius, apex, apex_radius).ok_or_else(|| {
                     tokens.error_at(line, column, "c", "cone base and apex coincide")
                 })?;

@@ -44,13 +44,21 @@ impl Cone {
     }
 
     /// Points `q` (relative to `base`) satisfy `|q_perp|^2 = (r0 + s z)^2`
-    /// with `z = q . axis`; the perpendicular parts are formed explicitly so
-    /// nothing cancels for rays that start far away.
+    /// with `z = q . axis`; the perpendicular parts are formed explicitly.
     /// The parameters where the ray's line meets the infinite cone, smaller
     /// first, and a test of whether a parameter lies on the finite part.
+    ///
+    /// The line is first re-based at its point nearest the axis segment
+    /// (as Haines et al., Ray Tracing Gems ch. 7, re-base sphere tests):
+    /// from an origin far away, `o_perp` and `d_perp` are nearly parallel
+    /// and rounding makes the discriminant `h^2 - a c` positive for lines
+    /// that pass far from a thin cone, hits the octree (which only looks
+    /// near the cone) would never see. The nearest point, not the
+    /// segment's middle: a cone can be far longer than the ray is long.
     #[inline]
     fn roots(&self, ray: &Ray) -> Option<((f64, f64), impl Fn(f64) -> bool)> {
-        let o = ray.origin - self.base;
+        let shift = self.nearest_to_axis(ray);
+        let o = (ray.origin + shift * ray.dir) - self.base;
         let (oz, dz) = (o.dot(self.axis), ray.dir.dot(self.axis));
         let o_perp = o - oz * self.axis;
         let d_perp = ray.dir - dz * self.axis;
@@ -58,13 +66,35 @@ impl Cone {
         let a = d_perp.length_squared() - self.slope * self.slope * dz * dz;
         let h = o_perp.dot(d_perp) - self.slope * dz * r_o;
         let c = o_perp.length_squared() - r_o * r_o;
-        let roots = solve_quadratic_half(a, h, c)?;
+        let (t0, t1) = solve_quadratic_half(a, h, c)?;
         let (height, base_radius, slope) = (self.height, self.base_radius, self.slope);
+        // Whether a parameter lies on the finite part, judged from the
+        // re-based origin (`t - shift` is off by one rounding of `t`).
         let on_part = move |t: f64| {
-            let z = oz + t * dz;
+            let z = oz + (t - shift) * dz;
             z >= 0.0 && z <= height && base_radius + slope * z >= 0.0
         };
-        Some((roots, on_part))
+        Some(((t0 + shift, t1 + shift), on_part))
+    }
+
+    /// The parameter of the ray's point nearest the axis segment (closest
+    /// points of a line and a segment: the segment's parameter clamped to
+    /// it, then the line's nearest to that point); 0 if not finite.
+    #[inline]
+    fn nearest_to_axis(&self, ray: &Ray) -> f64 {
+        let w = ray.origin - self.base;
+        let (dd, da) = (ray.dir.length_squared(), ray.dir.dot(self.axis));
+        let (dw, aw) = (ray.dir.dot(w), self.axis.dot(w));
+        let denominator = dd - da * da;
+        // Parallel (or nearly): any point of the axis is as near.
+        let s = if denominator > 1e-12 * dd {
+            (dd * aw - da * dw) / denominator
+        } else {
+            aw
+        };
+        let s = s.clamp(0.0, self.height);
+        let t = (da * s - dw) / dd;
+        if t.is_finite() { t } else { 0.0 }
     }
 
     #[inline]
@@ -206,6 +236,79 @@ mod tests {
             assert!(b.contains(tilted.base + 0.5 * rim) && b.contains(tilted.apex + 0.2 * rim));
         }
         assert!(Cone::new(DVec3::ONE, 1.0, DVec3::ONE, 1.0).is_none());
+    }
+
+    #[test]
+    fn cones_seen_from_far_away_are_hit_where_they_are() {
+        // Found by fuzzing (nff_scene): a shadow ray from 3e8 away hit a
+        // needle it passes metres from and missed a cone it goes through,
+        // and the octree, which only tests cones near them, disagreed with
+        // brute force.
+        let needle = Cone::new(
+            DVec3::new(0.0, 3.0, 0.0),
+            1e-9,
+            DVec3::new(5.0, 6.0, 0.0),
+            0.0,
+        )
+        .unwrap();
+        let wide = Cone::new(
+            DVec3::new(0.7, 7.0, -1.0),
+            0.0,
+            DVec3::new(3.0, 7.0, 5.0),
+            2.0,
+        )
+        .unwrap();
+        let light = DVec3::new(3.0, 3.0, 3.0);
+        let far = DVec3::new(-32431558.005971525, 293176397.1541214, 1224367.2118846006);
+        let ray = Ray::new(far, (light - far).normalize());
+        let t_max = light.distance(far);
+        assert!(needle.intersect(&ray, t_max).is_none());
+        assert!(needle.crossings(&ray, t_max).as_slice().is_empty());
+        assert_eq!(wide.crossings(&ray, t_max).as_slice().len(), 2);
+        // A cone far longer than the ray (fuzzing again: re-basing at the
+        // segment's middle, 2e9 away, made this ray hit it 17 from its axis).
+        let long = Cone::new(
+            DVec3::new(0.750948, 0.478724, 2.37111),
+            0.002734,
+            DVec3::new(4294967295.0, 0.488116, 2.38066),
+            0.00183195,
+        )
+        .unwrap();
+        let ground = Ray::new(
+            DVec3::new(
+                -13.27730228565912,
+                -3.7053492863348225,
+                0.0039062499990905053,
+            ),
+            DVec3::new(0.7353007712423545, -0.44675790606553667, 0.509647082968534),
+        );
+        assert!(long.intersect(&ground, 58.85659852163403).is_none());
+        let across = Ray::new(DVec3::new(1e3, 0.48, 10.0), -DVec3::Z);
+        let hit = long
+            .intersect(&across, f64::INFINITY)
+            .expect("crosses the axis");
+        assert!((across.at(hit.t).z - 2.37111).abs() < 0.003);
+        // Aimed at a point of the surface from ever farther away, a ray
+        // hits within rounding of it (the point's error grows with the
+        // distance travelled, about 1e-16 of it).
+        let (e1, e2) = crate::math::orthonormal_basis(wide.axis);
+        let z = 0.6 * wide.height;
+        let target = wide.base + z * wide.axis + (wide.slope * z) * e1;
+        // Coming from outside the surface there, so `target` is hit first.
+        let back = (e1 + 0.3 * e2 - 0.2 * wide.axis).normalize();
+        for exponent in 0..=12 {
+            let distance = 10f64.powi(exponent);
+            let from = target + distance * back;
+            let ray = Ray::new(from, (target - from).normalize());
+            let hit = wide.intersect(&ray, f64::INFINITY).unwrap_or_else(|| {
+                panic!("missed from {distance:e}");
+            });
+            let error = ray.at(hit.t).distance(target);
+            assert!(
+                error <= 1e-9 * distance.max(1.0),
+                "{error:e} from the aimed-at point at {distance:e}"
+            );
+        }
     }
 
     #[test]
