@@ -6,6 +6,7 @@
 
 use serde::Serialize;
 
+use crate::accel::QueryRecord;
 use crate::math::{Color, Ray};
 use crate::shapes::ShapeKind;
 
@@ -69,6 +70,10 @@ pub struct ShadowRecord {
     pub transmittance: f64,
     /// Diffuse and specular light this light adds (linear RGB).
     pub color: [f64; 3],
+    /// What the shadow ray's query did (`walk`, `walk_end` and its counts;
+    /// absent when no shadow ray was cast).
+    #[serde(flatten)]
+    pub query: Option<QueryRecord>,
 }
 
 /// One ray of the tree and what it brought back.
@@ -91,6 +96,10 @@ pub struct RayNode {
     pub color: [f64; 3],
     /// `weight * color`: what this ray adds to its parent.
     pub contribution: [f64; 3],
+    /// What the ray's closest-hit query did: `walk`, `walk_end` and its
+    /// Havran counts (README, "A ray's walk through the octree").
+    #[serde(flatten)]
+    pub query: Option<QueryRecord>,
     pub children: Vec<RayNode>,
 }
 
@@ -107,15 +116,16 @@ impl RayNode {
             weight,
             color: [0.0; 3],
             contribution: [0.0; 3],
+            query: None,
             children: Vec::new(),
         }
     }
 
     /// Every ray in the tree, depth first.
-    pub fn walk(&self) -> Vec<&RayNode> {
+    pub fn rays(&self) -> Vec<&RayNode> {
         let mut out = vec![self];
         for c in &self.children {
-            out.extend(c.walk());
+            out.extend(c.rays());
         }
         out
     }
@@ -129,6 +139,12 @@ pub trait RayRecorder: Sized {
     fn hit(&mut self, _record: impl FnOnce() -> HitRecord) {}
     #[inline(always)]
     fn shadow(&mut self, _record: impl FnOnce() -> ShadowRecord) {}
+    /// What the ray's closest-hit query did (its octree walk).
+    #[inline(always)]
+    fn query(&mut self, _record: impl FnOnce() -> Option<QueryRecord>) {}
+    /// What the shadow ray of the last [`RayRecorder::shadow`] did.
+    #[inline(always)]
+    fn shadow_query(&mut self, _record: impl FnOnce() -> Option<QueryRecord>) {}
     /// The material of the surface hit (cheap, for the adaptive sampler).
     #[inline(always)]
     fn material(&mut self, _index: u32) {}
@@ -163,6 +179,15 @@ impl RayRecorder for RayNode {
     }
     fn shadow(&mut self, record: impl FnOnce() -> ShadowRecord) {
         self.shadows.push(record());
+    }
+    fn query(&mut self, record: impl FnOnce() -> Option<QueryRecord>) {
+        self.query = record();
+    }
+    fn shadow_query(&mut self, record: impl FnOnce() -> Option<QueryRecord>) {
+        let record = record();
+        if let Some(shadow) = self.shadows.last_mut() {
+            shadow.query = record;
+        }
     }
     fn local(&mut self, color: Color) {
         self.local_color = color.to_array();

@@ -2,6 +2,8 @@
 //! every increment compiles to nothing, so counting costs only when asked for.
 //! [`RenderCounts`] gathers what a render counted, tile by tile and in all.
 
+use crate::accel::{CellVisit, QueryRecord, WalkEnd};
+
 /// Receives one call per unit of work done for a ray.
 pub trait Counter {
     #[inline(always)]
@@ -16,6 +18,22 @@ pub trait Counter {
     /// The same unit of work for `n` rays of a packet at once.
     #[inline(always)]
     fn add_lanes(&mut self, _tests: u32, _steps: u32, _leaves: u32) {}
+    /// The walk entered a cell (or passed an empty octant); called beside
+    /// `traversal_step`. Only [`WalkLog`](crate::accel::WalkLog) builds the visit.
+    #[inline(always)]
+    fn cell(&mut self, _visit: impl FnOnce() -> CellVisit) {}
+    /// Shape `object` was tested, beside `intersection_test`: where the ray
+    /// meets it, or `None`.
+    #[inline(always)]
+    fn tested(&mut self, _object: u32, _t: Option<f64>) {}
+    /// Why the walk stopped.
+    #[inline(always)]
+    fn walk_end(&mut self, _end: WalkEnd) {}
+    /// The query just finished, for explaining it ([`WalkLog`](crate::accel::WalkLog) only).
+    #[inline(always)]
+    fn take_query(&mut self) -> Option<QueryRecord> {
+        None
+    }
 }
 
 /// Counts nothing; the default.

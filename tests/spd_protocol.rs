@@ -214,7 +214,7 @@ fn depth_five_is_the_last_level() {
     text = text.replace("from 0 0 6", "from 0.1 0.1 6");
     let scene = scene_from(&text, "mirrors.nff");
     let tree = tree_at(&scene, spd(&scene), 2, 2);
-    let nodes = tree.walk();
+    let nodes = tree.rays();
     let deepest = nodes.iter().map(|n| n.depth).max().unwrap();
     assert_eq!(deepest, 5);
     assert_eq!(nodes.len(), 5, "one reflection per level");

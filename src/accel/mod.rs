@@ -4,6 +4,7 @@
 
 mod octree;
 mod primitives;
+mod walk_log;
 
 pub use octree::{
     DEFAULT_MEMORY_BUDGET_MIB, Octree, OctreeCell, OctreeError, OctreeParams, OctreeStats,
@@ -13,3 +14,4 @@ pub use primitives::{
     ClosestHit, MAX_SHADOW_CROSSINGS, Primitives, ShadowCrossings, closest_brute_force,
     occlusion_brute_force,
 };
+pub use walk_log::{CellVisit, QueryRecord, StepKind, Tested, WalkEnd, WalkLog, WalkStep};

@@ -152,7 +152,9 @@ pub(crate) fn test_closest<C: Counter>(
     } else {
         limit
     };
-    if let Some(hit) = prims.intersect(index, ray, probe) {
+    let found = prims.intersect(index, ray, probe);
+    counter.tested(index, found.map(|h| h.t));
+    if let Some(hit) = found {
         let better = match best {
             None => true,
             Some(b) => hit.t < b.hit.t || (hit.t == b.hit.t && index < b.shape),
@@ -286,16 +288,17 @@ pub(crate) fn test_occlusion<C: Counter>(
 ) -> bool {
     counter.intersection_test();
     if !prims.is_transparent(index) {
-        if prims.intersect(index, ray, t_max).is_some() {
+        let hit = prims.intersect(index, ray, t_max);
+        counter.tested(index, hit.map(|h| h.t));
+        if hit.is_some() {
             found.blocked = true;
         }
         return found.blocked;
     }
     // Transparent shapes are two-sided (light passes in and out).
-    for &t in prims.shapes[index as usize]
-        .crossings(ray, t_max)
-        .as_slice()
-    {
+    let crossings = prims.shapes[index as usize].crossings(ray, t_max);
+    counter.tested(index, crossings.as_slice().first().copied());
+    for &t in crossings.as_slice() {
         found.add(t, index);
     }
     false

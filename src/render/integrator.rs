@@ -67,8 +67,9 @@ impl Renderer<'_> {
         query: &mut Query<C>,
         rec: &mut R,
     ) -> Option<ShadingPoint> {
-        let hit = self.closest(&PreparedRay::new(*ray), query)?;
-        Some(self.shading_point_at(ray, &hit, rec))
+        let hit = self.closest(&PreparedRay::new(*ray), query);
+        rec.query(|| query.counter.take_query());
+        Some(self.shading_point_at(ray, &hit?, rec))
     }
 
     /// The hit `hit` of `ray` resolved for shading, told to `rec`.
@@ -155,6 +156,9 @@ impl Renderer<'_> {
             if let Some(direct) = self.light_through(ray, at, index, l, n_dot_l, pass, rec) {
                 color += direct;
             }
+            if self.settings.shadows {
+                rec.shadow_query(|| query.counter.take_query());
+            }
         }
         color
     }
@@ -217,6 +221,7 @@ impl Renderer<'_> {
             verdict: ShadowVerdict::FacesAway,
             transmittance: 0.0,
             color: [0.0; 3],
+            query: None,
         });
     }
 
@@ -240,6 +245,7 @@ impl Renderer<'_> {
             verdict,
             transmittance,
             color: color.to_array(),
+            query: None,
         };
         rec.light(index, pass > 0.0);
         if pass == 0.0 {

@@ -4,7 +4,7 @@
 //! the integrator asks.
 
 use crate::accel::{
-    ClosestHit, Octree, Primitives, ShadowCrossings, WalkStack, closest_brute_force,
+    ClosestHit, Octree, Primitives, ShadowCrossings, WalkLog, WalkStack, closest_brute_force,
     occlusion_brute_force,
 };
 use crate::camera::{Camera, CameraError, CameraSpec, sample_offsets};
@@ -16,7 +16,7 @@ use crate::scene::Scene;
 use crate::settings::{RenderSettings, Sides, ViewMode};
 use crate::shapes::PreparedRay;
 use crate::simd::SimdLevel;
-use crate::stats::{Counter, NoCounts, RayCounts};
+use crate::stats::{Counter, RayCounts};
 
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
@@ -250,8 +250,10 @@ impl<'a> Renderer<'a> {
         let mut root = RayNode::new(RayKind::Eye, &ray, 1, 1.0);
         let mut rays = RayCounts::default();
         let mut scratch = Scratch::default();
+        // The walk log counts too: each ray's record carries its walk.
+        let mut log = WalkLog::new(self.settings.use_octree);
         let mut query = Query {
-            counter: &mut NoCounts,
+            counter: &mut log,
             scratch: &mut scratch,
         };
         self.trace(&ray, 1, &mut query, &mut rays, &mut root);

@@ -7,6 +7,7 @@ use super::tree::Octree;
 use crate::accel::primitives::{
     ClosestHit, Primitives, ShadowCrossings, test_closest, test_occlusion,
 };
+use crate::accel::walk_log::{CellVisit, StepKind, WalkEnd};
 use crate::limits::MAX_OCTREE_DEPTH;
 use crate::shapes::PreparedRay;
 use crate::stats::Counter;
@@ -51,6 +52,7 @@ impl Octree {
         found.clear();
         for &i in &self.unbounded {
             if test_occlusion(prims, i, ray, t_max, found, counter) {
+                counter.walk_end(WalkEnd::Blocked);
                 return;
             }
         }
@@ -105,9 +107,11 @@ impl Octree {
         visitor: &mut V,
     ) {
         if self.nodes.is_empty() {
+            visitor.counter().walk_end(WalkEnd::MissedOctree);
             return;
         }
         let Some((t0, t1)) = self.root_range(ray, t_max) else {
+            visitor.counter().walk_end(WalkEnd::MissedOctree);
             return;
         };
         let o = ray.ray.origin.to_array();
@@ -127,22 +131,35 @@ impl Octree {
             // The stack holds cells in order along the ray, nearest on top:
             // once one starts past the limit, all the others do.
             if e.t0 > visitor.t_limit() {
+                visitor.counter().walk_end(V::BEYOND_LIMIT);
                 return;
             }
             visitor.counter().traversal_step();
             let node = self.nodes[e.node as usize];
+            let side = |level: u32| self.sides[level as usize & LEVEL_MASK];
+            let visit = |kind| CellVisit {
+                kind,
+                depth: e.level,
+                min: e.min,
+                side: side(e.level),
+                t_enter: e.t0,
+                t_exit: e.t1,
+            };
             if node.is_leaf() {
                 visitor.counter().leaf_visit();
+                visitor.counter().cell(|| visit(StepKind::Leaf));
                 let first = node.first as usize;
                 let refs = &self.refs[first..first + node.count() as usize];
                 if visitor.visit_leaf(refs, e.t1) {
+                    visitor.counter().walk_end(V::STOPPED);
                     return;
                 }
                 continue;
             }
+            visitor.counter().cell(|| visit(StepKind::Inner));
             // The children's side: the cell's half, exactly as the build
             // halves it.
-            let h = self.sides[(e.level + 1) as usize & LEVEL_MASK];
+            let h = side(e.level + 1);
             let mid = [e.min[0] + h, e.min[1] + h, e.min[2] + h];
             // Parameters of the three mid-planes, and the octant entered at
             // t0: on a plane's upper side once it is crossed going up, or
@@ -203,20 +220,29 @@ impl Octree {
             let mask = node.mask();
             for i in (0..=n).rev() {
                 let c = children[i];
+                let bit = |k: usize| (c >> k & 1) as f64;
+                let min = [
+                    e.min[0] + h * bit(0),
+                    e.min[1] + h * bit(1),
+                    e.min[2] + h * bit(2),
+                ];
                 if mask >> c & 1 == 0 {
                     if times[i] <= limit {
                         visitor.counter().traversal_step();
                         visitor.counter().leaf_visit();
+                        visitor.counter().cell(|| CellVisit {
+                            kind: StepKind::Empty,
+                            depth: e.level + 1,
+                            min,
+                            side: h,
+                            t_enter: times[i],
+                            t_exit: times[i + 1],
+                        });
                     }
                     continue;
                 }
-                let bit = |k: usize| (c >> k & 1) as f64;
                 entries[top & (STACK_CAPACITY - 1)] = Entry {
-                    min: [
-                        e.min[0] + h * bit(0),
-                        e.min[1] + h * bit(1),
-                        e.min[2] + h * bit(2),
-                    ],
+                    min,
                     t0: times[i],
                     t1: times[i + 1],
                     node: node.child(c),
@@ -225,6 +251,7 @@ impl Octree {
                 top += 1;
             }
         }
+        visitor.counter().walk_end(WalkEnd::LeftOctree);
     }
 }
 
@@ -287,6 +314,10 @@ trait LeafVisitor {
     fn visit_leaf(&mut self, refs: &[u32], t_exit: f64) -> bool;
     /// Cells starting beyond this parameter cannot change the answer.
     fn t_limit(&self) -> f64;
+    /// Why the walk ends when `visit_leaf` says stop, and when the next
+    /// cell starts beyond `t_limit`.
+    const STOPPED: WalkEnd;
+    const BEYOND_LIMIT: WalkEnd;
 }
 
 struct ClosestVisitor<'a, C> {
@@ -300,6 +331,8 @@ struct ClosestVisitor<'a, C> {
 
 impl<C: Counter> LeafVisitor for ClosestVisitor<'_, C> {
     type C = C;
+    const STOPPED: WalkEnd = WalkEnd::HitInCell;
+    const BEYOND_LIMIT: WalkEnd = WalkEnd::CellsBeyondHit;
     fn counter(&mut self) -> &mut C {
         self.counter
     }
@@ -339,6 +372,8 @@ struct OcclusionVisitor<'a, C> {
 
 impl<C: Counter> LeafVisitor for OcclusionVisitor<'_, C> {
     type C = C;
+    const STOPPED: WalkEnd = WalkEnd::Blocked;
+    const BEYOND_LIMIT: WalkEnd = WalkEnd::CellsBeyondLight;
     fn counter(&mut self) -> &mut C {
         self.counter
     }
