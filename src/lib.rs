@@ -37,3 +37,4 @@ pub mod simd;
 pub mod stats;
 #[cfg(feature = "gui")]
 pub mod viewer;
+pub mod walk_record;

@@ -6,9 +6,9 @@
 
 use serde::Serialize;
 
-use crate::accel::QueryRecord;
 use crate::math::{Color, Ray};
 use crate::shapes::ShapeKind;
+use crate::walk_record::QueryRecord;
 
 /// Why a ray was cast.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

@@ -2,7 +2,7 @@
 //! every increment compiles to nothing, so counting costs only when asked for.
 //! [`RenderCounts`] gathers what a render counted, tile by tile and in all.
 
-use crate::accel::{CellVisit, QueryRecord, WalkEnd};
+use crate::walk_record::{CellVisit, QueryRecord, WalkEnd};
 
 /// Receives one call per unit of work done for a ray.
 pub trait Counter {

@@ -6,12 +6,13 @@ mod octree;
 mod primitives;
 mod walk_log;
 
+pub use crate::walk_record::{CellVisit, QueryRecord, StepKind, Tested, WalkEnd, WalkStep};
 pub use octree::{
     DEFAULT_MEMORY_BUDGET_MIB, Octree, OctreeCell, OctreeError, OctreeParams, OctreeStats,
-    PacketStack, WalkStack,
+    PacketStack, PredictedCost, WalkStack,
 };
 pub use primitives::{
     ClosestHit, MAX_SHADOW_CROSSINGS, Primitives, ShadowCrossings, closest_brute_force,
     occlusion_brute_force,
 };
-pub use walk_log::{CellVisit, QueryRecord, StepKind, Tested, WalkEnd, WalkLog, WalkStep};
+pub use walk_log::WalkLog;

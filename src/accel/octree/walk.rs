@@ -7,10 +7,10 @@ use super::tree::Octree;
 use crate::accel::primitives::{
     ClosestHit, Primitives, ShadowCrossings, test_closest, test_occlusion,
 };
-use crate::accel::walk_log::{CellVisit, StepKind, WalkEnd};
 use crate::limits::MAX_OCTREE_DEPTH;
 use crate::shapes::PreparedRay;
 use crate::stats::Counter;
+use crate::walk_record::{CellVisit, StepKind, WalkEnd};
 
 impl Octree {
     /// Closest hit with `0 < t < t_max`; `stack` is the caller's scratch.
