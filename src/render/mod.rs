@@ -16,6 +16,7 @@ mod passes;
 mod sampling;
 mod tile_job;
 pub mod tiles;
+mod unit_costs;
 
 mod renderer;
 
@@ -24,6 +25,10 @@ pub use passes::{
     RenderedFrame,
 };
 pub use renderer::{RenderError, Renderer};
+pub use unit_costs::{
+    OctreeCandidate, Prediction, SUGGESTION_DEPTHS, SUGGESTION_LEAF_SIZES, UnitCosts, random_lines,
+    suggest_octree,
+};
 
 #[cfg(test)]
 mod tests {

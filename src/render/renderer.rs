@@ -65,6 +65,8 @@ pub struct Renderer<'a> {
     pub(super) octree: &'a Octree,
     pub(super) settings: RenderSettings,
     pub(super) camera: Camera,
+    /// What `camera` was made from (a thumbnail of the same view needs it).
+    pub(super) camera_spec: CameraSpec,
     /// Where in a pixel the rays of the full grid pass (the aa-need view
     /// compares one sample with 16 whatever `settings.samples` says).
     pub(super) grid: Vec<(f64, f64)>,
@@ -99,6 +101,7 @@ impl<'a> Renderer<'a> {
         camera: &CameraSpec,
     ) -> Result<Self, RenderError> {
         settings.check()?;
+        let camera_spec = *camera;
         let camera = Camera::new(camera, settings.width, settings.height)?;
         let is_transparent: Vec<bool> = scene
             .shape_materials
@@ -128,6 +131,7 @@ impl<'a> Renderer<'a> {
             octree,
             settings,
             camera,
+            camera_spec,
             grid: sample_offsets(if settings.view == ViewMode::AaNeed {
                 16
             } else {

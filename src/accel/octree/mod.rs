@@ -29,11 +29,13 @@ mod build;
 mod node;
 mod packet_walk;
 mod params;
+mod predict;
 mod tree;
 mod walk;
 
 pub use packet_walk::PacketStack;
 pub use params::{DEFAULT_MEMORY_BUDGET_MIB, OctreeCell, OctreeError, OctreeParams, OctreeStats};
+pub use predict::PredictedCost;
 pub use tree::Octree;
 pub use walk::WalkStack;
 

@@ -273,3 +273,60 @@ fn rays_in_split_planes_parallel_to_axes_and_through_corners_agree_with_brute_fo
         assert_eq!(checked, 24);
     }
 }
+
+#[test]
+fn predicted_cost_is_what_random_lines_through_the_root_meet() {
+    // Tiny spheres: rays almost never stop at a hit, which the prediction
+    // leaves out, so isotropic random lines (Crofton's measure) that cross
+    // the root must meet, on average, the predicted cells and references.
+    let shapes = sphere_grid(6, 1e-3);
+    for leaf_size in [1, 4] {
+        let params = OctreeParams {
+            leaf_size,
+            max_depth: 5,
+            ..OctreeParams::default()
+        };
+        let tree = Octree::build(&shapes, params).unwrap();
+        let predicted = tree.predicted_cost();
+        let prims = Primitives::opaque(&shapes);
+        let (mut counts, mut crossing) = (crate::stats::WorkCounts::default(), 0u32);
+        let mut stack = WalkStack::default();
+        for ray in crate::render::random_lines(tree.bounds(), 200_000) {
+            let mut one = crate::stats::WorkCounts::default();
+            tree.closest(
+                &prims,
+                &PreparedRay::new(ray),
+                f64::INFINITY,
+                &mut stack,
+                &mut one,
+            );
+            if one.traversal_steps > 0 {
+                crossing += 1;
+                counts += one;
+            }
+        }
+        assert!(crossing > 20_000, "{crossing} lines crossed the root");
+        let per_ray = |x: u64| x as f64 / crossing as f64;
+        let steps = per_ray(counts.traversal_steps);
+        let tests = per_ray(counts.intersection_tests);
+        let ratio_steps = steps / predicted.traversal_steps_per_ray;
+        let ratio_tests = tests / predicted.intersection_tests_per_ray;
+        assert!(
+            (ratio_steps - 1.0).abs() < 0.03 && (ratio_tests - 1.0).abs() < 0.05,
+            "leaf size {leaf_size}: steps {steps} vs {:?}, tests {tests}",
+            predicted
+        );
+    }
+    // One leaf: one step, every shape tested.
+    let one = Octree::build(
+        &shapes,
+        OctreeParams {
+            max_depth: 0,
+            ..OctreeParams::default()
+        },
+    )
+    .unwrap()
+    .predicted_cost();
+    assert_eq!(one.traversal_steps_per_ray, 1.0);
+    assert_eq!(one.intersection_tests_per_ray, shapes.len() as f64);
+}

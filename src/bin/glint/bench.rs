@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use anyhow::{Result, bail};
 use glint::accel::{Octree, OctreeStats};
-use glint::render::Renderer;
+use glint::render::{Prediction, Renderer, UnitCosts};
 use glint::settings::{Overrides, RenderSettings};
 use glint::stats::RenderCounts;
 use serde::Serialize;
@@ -112,6 +112,10 @@ struct SceneBench {
     octree_params: glint::accel::OctreeParams,
     octree_stats: OctreeStats,
     octree_on: Timing,
+    /// `octree_on` as predicted from the tree alone (README, "Predicting
+    /// an octree's cost"), at `unit_costs`.
+    predicted: Prediction,
+    unit_costs: UnitCosts,
     #[serde(skip_serializing_if = "Option::is_none")]
     octree_off: Option<Timing>,
     /// Brute force time over octree time, measured on the same rays.
@@ -181,6 +185,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         };
         let renderer_on = Renderer::new(&scene, &octree, on)?;
         let renderer_off = Renderer::new(&scene, &octree, off)?;
+        let unit_costs = UnitCosts::measure(&renderer_on, &octree)?;
 
         // One counted pass of each for the machine-independent figures.
         let (counted_on, counted_s) = timed(|| pool.install(|| renderer_on.render(true, None).1));
@@ -238,6 +243,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             octree_params: scene.octree_params,
             octree_stats: octree.stats(),
             octree_on: timing(&counted_on, on_s, rays_total as f64, false),
+            predicted: unit_costs.predict(octree.predicted_cost(), rays_total, threads),
+            unit_costs,
             // The whole-image estimate, with throughput measured on the subset.
             octree_off: counted_off
                 .as_ref()
@@ -378,6 +385,13 @@ struct SweepRow {
     traversal_steps_per_ray: f64,
     leaves_visited_per_ray: f64,
     octree_stats: OctreeStats,
+    /// The render as predicted from the tree alone, before it ran.
+    predicted: Prediction,
+    /// This scene's setting with the least predicted build plus render
+    /// time (the build measured, the render predicted).
+    suggested: bool,
+    /// This scene's setting with the least measured build plus render time.
+    fastest: bool,
 }
 
 fn sweep(args: &BenchArgs) -> Result<()> {
@@ -385,15 +399,22 @@ fn sweep(args: &BenchArgs) -> Result<()> {
     let mut rows = Vec::new();
     if args.format == Format::Markdown {
         println!(
-            "| scene | cost-driven | max depth | leaf size | max duplication | build (s) | render (s) | N_IT | N_TS | N_ETS | nodes | memory (KiB) |"
+            "| scene | cost-driven | max depth | leaf size | max duplication | build (s) | render (s) | predicted render (s) | N_IT | predicted N_IT | N_TS | predicted N_TS | N_ETS | nodes | memory (KiB) |"
         );
-        println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+        println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     }
+    let threads = pool.current_num_threads();
     for path in &args.scenes {
         let (mut scene, _) = load_scene(path)?;
         let mut settings = bench_settings(args, &mut scene);
         settings.use_octree = true;
         eprintln!("sweep {}", path.display());
+        // Unit costs once per scene, on its own octree setting.
+        let unit_costs = {
+            let octree = pool.install(|| Octree::build(&scene.shapes, scene.octree_params))?;
+            UnitCosts::measure(&Renderer::new(&scene, &octree, settings)?, &octree)?
+        };
+        let first_row = rows.len();
         let duplications = if args.sweep_max_duplications.is_empty() {
             vec![scene.octree_params.max_duplication]
         } else {
@@ -427,6 +448,9 @@ fn sweep(args: &BenchArgs) -> Result<()> {
             let Some(octree) = tree else {
                 bail!("no repeats")
             };
+            // The prediction comes first: it needs the tree, not the render
+            // (the ray count, which the octree does not change, excepted).
+            let predicted_cost = octree.predicted_cost();
             let renderer = Renderer::new(&scene, &octree, settings)?;
             let counts = pool.install(|| renderer.render(true, None).1);
             for _ in 0..args.repeat {
@@ -444,11 +468,18 @@ fn sweep(args: &BenchArgs) -> Result<()> {
                 traversal_steps_per_ray: counts.work.traversal_steps as f64 / total,
                 leaves_visited_per_ray: counts.work.leaves_visited as f64 / total,
                 octree_stats: octree.stats(),
+                predicted: unit_costs.predict(predicted_cost, counts.rays.total(), threads),
+                suggested: false,
+                fastest: false,
             };
             if args.format == Format::Markdown {
                 print_sweep_row(&row);
             }
             rows.push(row);
+        }
+        mark_suggested_and_fastest(&mut rows[first_row..]);
+        if args.format == Format::Markdown {
+            print_suggestion(&rows[first_row..]);
         }
     }
     if args.format == Format::Json {
@@ -457,12 +488,60 @@ fn sweep(args: &BenchArgs) -> Result<()> {
     Ok(())
 }
 
+/// Marks the row with the least predicted build + render and the one with
+/// the least measured build + render (the first of equals).
+fn mark_suggested_and_fastest(rows: &mut [SweepRow]) {
+    let least = |rows: &[SweepRow], cost: fn(&SweepRow) -> f64| {
+        (0..rows.len()).min_by(|&a, &b| cost(&rows[a]).total_cmp(&cost(&rows[b])))
+    };
+    if let Some(i) = least(rows, |r| r.build_s + r.predicted.render_s) {
+        rows[i].suggested = true;
+    }
+    if let Some(i) = least(rows, |r| r.build_s + r.render_s) {
+        rows[i].fastest = true;
+    }
+}
+
+/// One line under a scene's sweep: the suggested setting, and how its
+/// measured time compares with the sweep's best.
+fn print_suggestion(rows: &[SweepRow]) {
+    let (Some(s), Some(f)) = (
+        rows.iter().find(|r| r.suggested),
+        rows.iter().find(|r| r.fastest),
+    ) else {
+        return;
+    };
+    let describe = |r: &SweepRow| {
+        format!(
+            "max depth {}, leaf size {}, max duplication {}, cost-driven {}",
+            r.octree_params.max_depth,
+            r.octree_params.leaf_size,
+            r.octree_params.max_duplication,
+            if r.octree_params.cost_driven {
+                "on"
+            } else {
+                "off"
+            }
+        )
+    };
+    println!(
+        "\nSuggested for {} (least predicted build + render): {}: {:.3} s measured; \
+         the sweep's fastest: {}: {:.3} s ({:.2}x).\n",
+        s.scene,
+        describe(s),
+        s.build_s + s.render_s,
+        describe(f),
+        f.build_s + f.render_s,
+        (s.build_s + s.render_s) / (f.build_s + f.render_s).max(1e-12)
+    );
+}
+
 fn print_sweep_row(r: &SweepRow) {
     let name = std::path::Path::new(&r.scene)
         .file_name()
         .map_or(r.scene.clone(), |n| n.to_string_lossy().into_owned());
     println!(
-        "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.2} | {:.2} | {:.2} | {} | {:.0} |",
+        "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {:.0} |",
         name,
         if r.octree_params.cost_driven {
             "on"
@@ -474,8 +553,11 @@ fn print_sweep_row(r: &SweepRow) {
         r.octree_params.max_duplication,
         r.build_s,
         r.render_s,
+        r.predicted.render_s,
         r.intersection_tests_per_ray,
+        r.predicted.intersection_tests_per_ray,
         r.traversal_steps_per_ray,
+        r.predicted.traversal_steps_per_ray,
         r.leaves_visited_per_ray,
         r.octree_stats.nodes,
         r.octree_stats.memory_bytes as f64 / 1024.0
