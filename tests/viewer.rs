@@ -807,3 +807,65 @@ fn an_export_after_save_as_records_the_file_its_image_was_rendered_from() {
     assert_eq!(name, std::fs::canonicalize(&copy).unwrap());
     assert_eq!(text, std::fs::read_to_string(&copy).unwrap());
 }
+
+#[test]
+fn octree_parameters_rebuild_the_tree_and_its_prediction_without_rendering() {
+    let mut h = harness(app_for("scenes/spd/teapot.nff", 96, 96));
+    settle(&mut h);
+    h.run_steps(2);
+    assert!(
+        h.state().unit_costs().is_some(),
+        "measured once the scene rendered"
+    );
+    let generation = h.state().worker().generation();
+    let coarse = h.state().octree().stats();
+    let coarse_cost = h.state().octree().predicted_cost();
+    let mut params = h.state().scene().octree_params;
+    params.leaf_size = 1;
+    params.max_depth = 8;
+    h.state_mut().set_octree_params(params);
+    h.run_steps(3);
+    assert_eq!(h.state().scene().octree_params, params);
+    assert_ne!(h.state().octree().stats().nodes, coarse.nodes, "rebuilt");
+    assert_ne!(h.state().octree().predicted_cost(), coarse_cost);
+    assert_eq!(
+        h.state().worker().generation(),
+        generation,
+        "nothing rendered"
+    );
+    // The panel shows the prediction for the last pass's rays.
+    h.get_by_label("Octree parameters").click();
+    h.run_steps(2);
+    let shown = h
+        .get_all_by(|n| {
+            n.label()
+                .or(n.value())
+                .is_some_and(|t| t.starts_with("Predicted 1-sample pass"))
+        })
+        .count();
+    assert!(shown > 0, "the predicted render time is shown");
+}
+
+#[test]
+fn a_rays_walk_steps_through_the_octree_in_the_panel() {
+    let mut h = harness(app_for("scenes/spd/teapot.nff", 96, 96));
+    settle(&mut h);
+    h.state_mut().inspect_pixel(48, 46);
+    h.run_steps(3);
+    let tree = &h.state().inspection().unwrap().tree;
+    let steps = tree.query.as_ref().unwrap().walk.as_ref().unwrap().len();
+    assert!(steps > 2, "{steps} steps");
+    // The eye ray's "walk" button is the first.
+    h.get_all_by_label("walk").next().unwrap().click();
+    h.run_steps(2);
+    assert_eq!(h.state().walk().0.map(|t| t.path.len()), Some(0));
+    assert_eq!(h.state().walk().1, 0);
+    h.get_by_label(">").click();
+    h.run_steps(1);
+    h.get_by_label(">").click();
+    h.run_steps(1);
+    assert_eq!(h.state().walk().1, 2, "two steps taken");
+    h.get_by_label("|<").click();
+    h.run_steps(1);
+    assert_eq!(h.state().walk().1, 0);
+}

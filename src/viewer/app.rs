@@ -11,15 +11,18 @@ use egui::{Color32, Sense, TextureHandle, TextureOptions};
 use super::command::Command;
 use super::compare::{Compare, CompareMode, DiffStats};
 use super::inspect::InspectState;
+use super::octree_panel::{OctreeInfo, SuggestionJob, last_full_pass};
 use super::panels::{Message, RenderInfo};
 use super::pixel::Inspection;
+use super::pixel::WalkTarget;
 use super::screenshot::Screenshot;
 pub use super::state::{CompareSetting, SceneSource};
 use super::state::{EditState, Magnification, Snapshot};
 use super::worker::{Job, Preview, Worker};
 use super::{budget, export, input, panels, save, timing};
-use crate::accel::Octree;
+use crate::accel::{Octree, OctreeParams};
 use crate::camera::CameraSpec;
+use crate::render::{Renderer, UnitCosts};
 use crate::scene::Scene;
 use crate::settings::{AntiAliasing, Overrides, RenderSettings};
 
@@ -48,6 +51,8 @@ pub struct ViewerOptions {
     pub overlay_depth: Option<u32>,
     /// Start with this pixel's ray tree inspected.
     pub inspect: Option<(u32, u32)>,
+    /// And this ray's octree walk shown, to this many steps (`None`: all).
+    pub walk: Option<(WalkTarget, Option<usize>)>,
     /// Start by comparing against the image with this setting flipped:
     /// A is rendered with it flipped and pinned, then B as given.
     pub compare: Option<CompareSetting>,
@@ -90,6 +95,12 @@ pub struct GlintApp {
     // is on screen.
     octree: Arc<Octree>,
     build_seconds: f64,
+    /// What a traversal step, an intersection test and the rest of a ray
+    /// cost here, measured on the scene when it was installed: they turn
+    /// the octree's predicted work into a predicted time.
+    unit_costs: Option<UnitCosts>,
+    /// A suggested octree setting, being worked out or found.
+    suggestion: Option<SuggestionJob>,
     worker: Worker,
     texture: Option<TextureHandle>,
     shown_version: u64,
@@ -146,6 +157,8 @@ impl GlintApp {
             magnification: Magnification::default(),
             octree: Arc::new(octree),
             build_seconds,
+            unit_costs: None,
+            suggestion: None,
             worker,
             texture: None,
             shown_version: 0,
@@ -164,6 +177,10 @@ impl GlintApp {
         };
         if let Some((i, j)) = options.inspect {
             app.inspect_pixel(i, j);
+        }
+        if let Some((target, step)) = options.walk {
+            app.inspect.walk.target = Some(target);
+            app.inspect.walk.shown = step.unwrap_or(usize::MAX);
         }
         Ok(app)
     }
@@ -329,10 +346,20 @@ impl GlintApp {
             .resizable(false)
             .exact_size(330.0)
             .show(ui, |ui| {
+                let history = self.worker.history();
+                let octree = OctreeInfo {
+                    octree: &self.octree,
+                    build_seconds: self.build_seconds,
+                    unit_costs: self.unit_costs,
+                    last_pass: last_full_pass(&history),
+                    threads: self.worker.threads(),
+                    suggestion: self.suggestion.as_ref(),
+                };
                 commands.extend(panels::controls_ui(
                     &mut self.edit,
                     &mut self.inspect,
                     &self.worker,
+                    &octree,
                     ui,
                 ))
             });
@@ -340,11 +367,12 @@ impl GlintApp {
             .resizable(false)
             .exact_size(330.0)
             .show(ui, |ui| {
-                timing::timing_ui(&self.edit, &info, &self.inspect, ui)
+                timing::timing_ui(&self.edit, &info, &mut self.inspect, ui)
             });
         egui::CentralPanel::default_margins().show(ui, |ui| commands.extend(self.image_ui(ui)));
         self.discard_prompt_ui(&ctx);
         self.apply(commands, &ctx);
+        self.octree_tuning_logic(&ctx);
         self.undoer
             .feed_state(ctx.input(|i| i.time), &self.edit.snapshot());
         self.title_logic(&ctx);
@@ -434,6 +462,8 @@ impl GlintApp {
                 Command::Export => self.export(),
                 Command::InspectPixel(i, j) => self.inspect_pixel(i, j),
                 Command::PinAsA => self.pin_as_a(),
+                Command::SetOctreeParams(params) => self.set_octree_params(params),
+                Command::SuggestOctree => self.suggest_octree(),
                 Command::Quit => ctx.send_viewport_cmd(egui::ViewportCommand::Close),
             }
         }
@@ -721,7 +751,85 @@ impl GlintApp {
         self.undoer = Default::default();
         self.octree = Arc::new(octree);
         self.build_seconds = seconds;
+        // Measured again on the new scene once it has rendered.
+        self.unit_costs = None;
         Ok(())
+    }
+
+    pub fn octree(&self) -> &Octree {
+        &self.octree
+    }
+
+    /// The unit costs measured on this scene (once its first pass is in).
+    pub fn unit_costs(&self) -> Option<UnitCosts> {
+        self.unit_costs
+    }
+
+    /// The ray whose octree walk is shown, and how many steps.
+    pub fn walk(&self) -> (Option<&WalkTarget>, usize) {
+        (self.inspect.walk.target.as_ref(), self.inspect.walk.shown)
+    }
+
+    /// Rebuilds the octree with `params`. Renders nothing: the next render
+    /// (of whatever else changes) uses the new tree.
+    pub fn set_octree_params(&mut self, params: OctreeParams) {
+        let mut scene = (*self.edit.scene).clone();
+        scene.octree_params = params;
+        match build_octree(&scene) {
+            Ok((octree, seconds)) => {
+                self.octree = Arc::new(octree);
+                self.build_seconds = seconds;
+                self.edit.scene = Arc::new(scene);
+            }
+            Err(e) => self.say(format!("octree not rebuilt: {e}"), true),
+        }
+    }
+
+    /// Starts working out a suggested octree setting in the background,
+    /// for the last full pass's rays.
+    fn suggest_octree(&mut self) {
+        let history = self.worker.history();
+        let (Some(costs), Some(pass)) = (self.unit_costs, last_full_pass(&history)) else {
+            return;
+        };
+        self.suggestion = Some(SuggestionJob::start(
+            Arc::clone(&self.edit.scene),
+            costs,
+            pass.rays.total(),
+            self.worker.threads(),
+            self.edit.scene_version,
+        ));
+    }
+
+    /// Measures the unit costs of the installed scene once its first pass
+    /// has shown it renders (a thumbnail render, some tens of milliseconds),
+    /// and drops a suggestion made for another scene.
+    fn octree_tuning_logic(&mut self, ctx: &egui::Context) {
+        if self
+            .suggestion
+            .as_ref()
+            .is_some_and(|s| s.scene_version != self.edit.scene_version)
+        {
+            self.suggestion = None;
+        }
+        if self
+            .suggestion
+            .as_ref()
+            .is_some_and(|s| s.result().is_none())
+        {
+            ctx.request_repaint_after(std::time::Duration::from_millis(100));
+        }
+        if self.unit_costs.is_none() && !self.worker.history().is_empty() {
+            let settings = RenderSettings {
+                use_octree: true,
+                ..self.edit.settings
+            };
+            if let Ok(renderer) =
+                Renderer::with_camera(&self.edit.scene, &self.octree, settings, &self.edit.camera)
+            {
+                self.unit_costs = UnitCosts::measure(&renderer, &self.octree).ok();
+            }
+        }
     }
 
     fn open_dialog(&mut self) {

@@ -27,5 +27,10 @@ pub enum Command {
     InspectPixel(u32, u32),
     /// Keep the frame on screen as "A" of an A/B comparison.
     PinAsA,
+    /// Rebuild the octree with these parameters (renders nothing: the
+    /// image does not depend on them).
+    SetOctreeParams(crate::accel::OctreeParams),
+    /// Work out a suggested octree setting in the background.
+    SuggestOctree,
     Quit,
 }

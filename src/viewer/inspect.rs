@@ -26,6 +26,8 @@ pub struct InspectState {
     /// Clicking the image picks a pixel (Ctrl+click does so any time).
     pub inspect_mode: bool,
     pub inspection: Option<Inspection>,
+    /// One of the inspected pixel's rays stepping through the octree.
+    pub walk: super::walk_view::WalkView,
     pub compare: Option<Compare>,
 }
 
@@ -154,6 +156,7 @@ impl InspectState {
         if let Some(ins) = &self.inspection {
             let extent = edit.scene.extent_bounds().extent().length().max(1e-9);
             ins.draw(&painter, &camera, image_rect, extent);
+            super::walk_view::draw_walk(ins, &self.walk, &painter, &camera, image_rect);
         }
     }
 }

@@ -11,6 +11,7 @@ pub mod compare;
 mod export;
 mod input;
 pub mod inspect;
+mod octree_panel;
 mod orbit;
 mod panels;
 pub mod pixel;
@@ -18,7 +19,9 @@ mod save;
 mod screenshot;
 pub mod state;
 mod timing;
+mod walk_view;
 pub mod worker;
 
 pub use app::{GlintApp, ViewerOptions};
+pub use pixel::WalkTarget;
 pub use state::SceneSource;

@@ -127,6 +127,7 @@ pub fn controls_ui(
     edit: &mut EditState,
     inspect: &mut InspectState,
     worker: &Worker,
+    octree: &super::octree_panel::OctreeInfo,
     ui: &mut egui::Ui,
 ) -> Vec<Command> {
     let mut commands = Vec::new();
@@ -143,6 +144,15 @@ pub fn controls_ui(
                 commands.extend(super::inspect::inspect_controls_ui(
                     inspect, worker, &label, ui,
                 ));
+            });
+        egui::CollapsingHeader::new("Octree parameters")
+            .default_open(false)
+            .show(ui, |ui| {
+                commands.extend(super::octree_panel::octree_ui(
+                    edit.scene.octree_params,
+                    octree,
+                    ui,
+                ))
             });
         egui::CollapsingHeader::new("Camera")
             .default_open(true)

@@ -11,6 +11,14 @@ use crate::ray_tree::{RayKind, RayNode, ShadowVerdict};
 use crate::render::{RenderError, Renderer};
 use crate::settings::{RenderSettings, ViewMode};
 
+/// Which ray's walk is shown: the children's indices from the eye ray
+/// down, and a light's index for that ray's shadow ray.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct WalkTarget {
+    pub path: Vec<usize>,
+    pub shadow: Option<usize>,
+}
+
 /// The inspected pixel and the tree of rays its centre ray spawned.
 #[derive(Clone, Debug)]
 pub struct Inspection {
@@ -151,11 +159,12 @@ fn rgb_text(c: [f64; 3]) -> String {
     format!("({:.3}, {:.3}, {:.3})", c[0], c[1], c[2])
 }
 
-/// The inspected pixel's ray tree as nested, collapsible rows.
-pub fn ray_tree_ui(inspection: Option<&Inspection>, ui: &mut egui::Ui) {
+/// The inspected pixel's ray tree as nested, collapsible rows; the ray
+/// whose "walk" button was clicked, if one was.
+pub fn ray_tree_ui(inspection: Option<&Inspection>, ui: &mut egui::Ui) -> Option<WalkTarget> {
     let Some(ins) = inspection else {
         ui.label("Ctrl+click the image (or turn on Inspect and click) to see a pixel's rays.");
-        return;
+        return None;
     };
     ui.label(format!(
         "pixel {},{} — colour {}",
@@ -163,10 +172,17 @@ pub fn ray_tree_ui(inspection: Option<&Inspection>, ui: &mut egui::Ui) {
         ins.pixel.1,
         rgb_text(ins.tree.color)
     ));
-    node_ui(ui, &ins.tree, "ray");
+    let mut picked = None;
+    node_ui(ui, &ins.tree, &mut Vec::new(), &mut picked);
+    picked
 }
 
-fn node_ui(ui: &mut egui::Ui, node: &RayNode, path: &str) {
+fn node_ui(
+    ui: &mut egui::Ui,
+    node: &RayNode,
+    path: &mut Vec<usize>,
+    picked: &mut Option<WalkTarget>,
+) {
     let kind = match node.kind {
         RayKind::Eye => "eye",
         RayKind::Reflection => "reflection",
@@ -186,9 +202,19 @@ fn node_ui(ui: &mut egui::Ui, node: &RayNode, path: &str) {
         egui::RichText::new(format!("{kind} ray, depth {}: {what}", node.depth))
             .color(kind_color(node.kind)),
     )
-    .id_salt(path)
+    .id_salt(("ray", path.clone()))
     .default_open(node.depth <= 2)
     .show(ui, |ui| {
+        if ui
+            .small_button("walk")
+            .on_hover_text("step through this ray's octree walk")
+            .clicked()
+        {
+            *picked = Some(WalkTarget {
+                path: path.clone(),
+                shadow: None,
+            });
+        }
         let v = |v: [f64; 3]| format!("({:.4}, {:.4}, {:.4})", v[0], v[1], v[2]);
         ui.label(format!("origin {}", v(node.origin)));
         ui.label(format!("direction {}", v(node.direction)));
@@ -201,13 +227,26 @@ fn node_ui(ui: &mut egui::Ui, node: &RayNode, path: &str) {
             ));
         }
         for s in &node.shadows {
-            ui.label(format!(
-                "light {}: {} (transmittance {:.3}) adds {}",
-                s.light,
-                s.verdict.name(),
-                s.transmittance,
-                rgb_text(s.color)
-            ));
+            ui.horizontal(|ui| {
+                ui.label(format!(
+                    "light {}: {} (transmittance {:.3}) adds {}",
+                    s.light,
+                    s.verdict.name(),
+                    s.transmittance,
+                    rgb_text(s.color)
+                ));
+                if s.query.is_some()
+                    && ui
+                        .small_button("walk")
+                        .on_hover_text("step through this shadow ray's octree walk")
+                        .clicked()
+                {
+                    *picked = Some(WalkTarget {
+                        path: path.clone(),
+                        shadow: Some(s.light),
+                    });
+                }
+            });
         }
         ui.label(format!("local {}", rgb_text(node.local_color)));
         ui.label(format!(
@@ -217,7 +256,9 @@ fn node_ui(ui: &mut egui::Ui, node: &RayNode, path: &str) {
             rgb_text(node.contribution)
         ));
         for (k, c) in node.children.iter().enumerate() {
-            node_ui(ui, c, &format!("{path}/{k}"));
+            path.push(k);
+            node_ui(ui, c, path, picked);
+            path.pop();
         }
     });
 }

@@ -13,7 +13,12 @@ use crate::settings::ViewMode;
 
 /// Pass times and ray counts, the octree's figures, the view's legend and
 /// the inspected pixel's ray tree.
-pub fn timing_ui(edit: &EditState, info: &RenderInfo, inspect: &InspectState, ui: &mut egui::Ui) {
+pub fn timing_ui(
+    edit: &EditState,
+    info: &RenderInfo,
+    inspect: &mut InspectState,
+    ui: &mut egui::Ui,
+) {
     // Scrolls both ways: a deep ray tree's headers (which do not wrap) must
     // not widen the fixed-width panel over the image.
     egui::ScrollArea::both().show(ui, |ui| {
@@ -21,7 +26,18 @@ pub fn timing_ui(edit: &EditState, info: &RenderInfo, inspect: &InspectState, ui
         legend_ui(info.worker, ui);
         ui.separator();
         ui.heading("Pixel");
-        super::pixel::ray_tree_ui(inspect.inspection.as_ref(), ui);
+        // The walk first once a ray is picked: the tree can be long.
+        if inspect.inspection.is_some() && inspect.walk.target.is_some() {
+            ui.label(egui::RichText::new("Octree walk").strong());
+            super::walk_view::walk_ui(inspect.inspection.as_ref(), &mut inspect.walk, ui);
+            ui.separator();
+        }
+        let picked = super::pixel::ray_tree_ui(inspect.inspection.as_ref(), ui);
+        if let Some(target) = picked {
+            inspect.walk.target = Some(target);
+            inspect.walk.shown = 0;
+            inspect.walk.playing = false;
+        }
     });
 }
 

@@ -219,6 +219,8 @@ impl Shared {
 
 /// Handle owned by the UI. Dropping it stops and joins the thread.
 pub struct Worker {
+    /// Render threads (0 asked for: one per core).
+    threads: usize,
     shared: Arc<Shared>,
     jobs: Option<Sender<(u64, Job)>>,
     thread: Option<JoinHandle<()>>,
@@ -250,11 +252,22 @@ impl Worker {
                 None
             }
         };
+        let threads = if threads == 0 {
+            std::thread::available_parallelism().map_or(1, |n| n.get())
+        } else {
+            threads
+        };
         Self {
+            threads,
             shared,
             jobs: Some(tx),
             thread,
         }
+    }
+
+    /// How many threads render.
+    pub fn threads(&self) -> usize {
+        self.threads
     }
 
     /// Starts rendering `job`, abandoning whatever was in flight. Returns

@@ -45,6 +45,14 @@ pub struct ViewArgs {
     /// Start with pixel X,Y's ray tree inspected (from the top-left, from 0).
     #[arg(long, value_name = "X,Y", value_parser = parse_pixel)]
     pub inspect: Option<(u32, u32)>,
+    /// With --inspect: start stepping through this ray's octree walk:
+    /// `eye`, then the children's indices (`eye/0` is the eye ray's first
+    /// secondary ray), and `/shadow/L` for the shadow ray to light L.
+    #[arg(long, value_name = "RAY", requires = "inspect", value_parser = parse_walk)]
+    pub walk: Option<glint::viewer::WalkTarget>,
+    /// With --walk: the steps shown (default: the whole walk).
+    #[arg(long, value_name = "N", requires = "walk")]
+    pub walk_step: Option<usize>,
     /// Start with an A/B comparison: A is rendered with this setting
     /// flipped and pinned, then B renders as given.
     #[arg(long, value_enum)]
@@ -77,6 +85,8 @@ impl Default for ViewArgs {
             window: (1400, 860),
             overlay_depth: None,
             inspect: None,
+            walk: None,
+            walk_step: None,
             compare: None,
             compare_difference: false,
             rules: RulesArgs::default(),
@@ -137,6 +147,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         overrides,
         overlay_depth: args.overlay_depth,
         inspect: args.inspect,
+        walk: args.walk.clone().map(|target| (target, args.walk_step)),
         compare: args.compare.map(|c| match c {
             CompareArg::Octree => CompareSetting::Octree,
             CompareArg::Aa => CompareSetting::AntiAliasing,
@@ -170,4 +181,30 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         }),
     )
     .map_err(|e| anyhow!("the viewer window failed: {e}"))
+}
+
+/// `eye[/K...][/shadow/L]` as a walk target.
+fn parse_walk(text: &str) -> Result<glint::viewer::WalkTarget, String> {
+    let bad = || {
+        format!(
+            "{text:?}: give eye, then child indices, then optionally shadow/LIGHT (e.g. eye/0/shadow/1)"
+        )
+    };
+    let mut parts = text.split('/');
+    if parts.next() != Some("eye") {
+        return Err(bad());
+    }
+    let mut target = glint::viewer::WalkTarget::default();
+    while let Some(part) = parts.next() {
+        if part == "shadow" {
+            let light = parts.next().and_then(|l| l.parse().ok()).ok_or_else(bad)?;
+            if parts.next().is_some() {
+                return Err(bad());
+            }
+            target.shadow = Some(light);
+            break;
+        }
+        target.path.push(part.parse().map_err(|_| bad())?);
+    }
+    Ok(target)
 }

@@ -1,0 +1,216 @@
+//! The octree's parameters, what the tree they build is predicted to cost
+//! (before any render: the tree is rebuilt, nothing is rendered), and a
+//! suggested setting worked out in the background, applied with a click.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+
+use egui::DragValue;
+
+use super::command::Command;
+use super::worker::{PassKind, PassRecord};
+use crate::accel::{Octree, OctreeParams};
+use crate::limits::MAX_OCTREE_DEPTH;
+use crate::render::{OctreeCandidate, Prediction, UnitCosts, suggest_octree};
+use crate::scene::Scene;
+
+/// A suggestion being worked out on its own thread, for one scene version.
+pub struct SuggestionJob {
+    pub scene_version: u64,
+    /// `None` while it runs; then the suggested candidate (`None` if no
+    /// setting fitted the memory budget).
+    result: Arc<Mutex<Option<Option<OctreeCandidate>>>>,
+    cancel: Arc<AtomicBool>,
+}
+
+impl SuggestionJob {
+    /// Builds the suggestion grid's trees (renders nothing) for `rays`
+    /// rays on `threads` threads.
+    pub fn start(
+        scene: Arc<Scene>,
+        costs: UnitCosts,
+        rays: u64,
+        threads: usize,
+        scene_version: u64,
+    ) -> Self {
+        let result = Arc::new(Mutex::new(None));
+        let cancel = Arc::new(AtomicBool::new(false));
+        let (out, stop) = (Arc::clone(&result), Arc::clone(&cancel));
+        std::thread::spawn(move || {
+            let keep_going = || !stop.load(Ordering::Relaxed);
+            let found = suggest_octree(
+                &scene.shapes,
+                scene.octree_params,
+                &costs,
+                rays,
+                threads,
+                &keep_going,
+            );
+            if let Ok(mut slot) = out.lock() {
+                *slot = Some(found.map(|(candidates, best)| candidates[best]));
+            }
+        });
+        Self {
+            scene_version,
+            result,
+            cancel,
+        }
+    }
+
+    /// `None` while it runs.
+    pub fn result(&self) -> Option<Option<OctreeCandidate>> {
+        self.result.lock().ok().and_then(|r| *r)
+    }
+}
+
+impl Drop for SuggestionJob {
+    fn drop(&mut self) {
+        self.cancel.store(true, Ordering::Relaxed);
+    }
+}
+
+/// What the panel shows besides the parameters.
+pub struct OctreeInfo<'a> {
+    pub octree: &'a Octree,
+    pub build_seconds: f64,
+    pub unit_costs: Option<UnitCosts>,
+    /// The last full pass: its rays are what a render will cast again (the
+    /// octree changes the time, never the rays).
+    pub last_pass: Option<&'a PassRecord>,
+    pub threads: usize,
+    pub suggestion: Option<&'a SuggestionJob>,
+}
+
+/// The last pass that was not a drag preview.
+pub fn last_full_pass(history: &[PassRecord]) -> Option<&PassRecord> {
+    history
+        .iter()
+        .rev()
+        .find(|r| !matches!(r.kind, PassKind::Preview(_)))
+}
+
+/// The prediction for the current tree and the last pass's rays.
+pub fn prediction(info: &OctreeInfo) -> Option<(Prediction, &'static str)> {
+    let costs = info.unit_costs?;
+    let pass = info.last_pass?;
+    let kind = match pass.kind {
+        PassKind::SixteenSamples => "16-sample pass",
+        PassKind::Corners => "SPD pass",
+        _ => "1-sample pass",
+    };
+    Some((
+        costs.predict(
+            info.octree.predicted_cost(),
+            pass.rays.total(),
+            info.threads,
+        ),
+        kind,
+    ))
+}
+
+pub fn octree_ui(params: OctreeParams, info: &OctreeInfo, ui: &mut egui::Ui) -> Vec<Command> {
+    let mut commands = Vec::new();
+    let mut edited = params;
+    egui::Grid::new("octree parameters")
+        .num_columns(2)
+        .show(ui, |ui| {
+            ui.label("Max depth");
+            ui.add(
+                DragValue::new(&mut edited.max_depth)
+                    .update_while_editing(false)
+                    .range(0..=MAX_OCTREE_DEPTH),
+            )
+            .on_hover_text("deepest level a cell is split to (root = 0)");
+            ui.end_row();
+            ui.label("Leaf size");
+            ui.add(
+                DragValue::new(&mut edited.leaf_size)
+                    .update_while_editing(false)
+                    .range(1..=1024),
+            )
+            .on_hover_text("references up to which a node stays a leaf");
+            ui.end_row();
+            ui.label("Max duplication");
+            ui.add(
+                DragValue::new(&mut edited.max_duplication)
+                    .update_while_editing(false)
+                    .range(1..=8),
+            )
+            .on_hover_text(
+                "keep a node a leaf when its children would hold more than this many times \
+                 its references (8 never stops a split)",
+            );
+            ui.end_row();
+            ui.label("Cost-driven");
+            ui.checkbox(&mut edited.cost_driven, "")
+                .on_hover_text("let the surface-area cost estimate stop subdivision early");
+            ui.end_row();
+        });
+    if edited != params {
+        commands.push(Command::SetOctreeParams(edited));
+    }
+    let stats = info.octree.stats();
+    ui.label(format!(
+        "{} nodes ({} leaves, {} empty), {:.1} KiB, built in {:.3} s",
+        stats.nodes,
+        stats.leaves,
+        stats.empty_leaves,
+        stats.memory_bytes as f64 / 1024.0,
+        info.build_seconds
+    ));
+    let cost = info.octree.predicted_cost();
+    ui.label(format!(
+        "Predicted per ray: {:.1} traversal steps, {:.1} intersection tests",
+        cost.traversal_steps_per_ray, cost.intersection_tests_per_ray
+    ))
+    .on_hover_text(
+        "from the tree alone (surface areas: a ray crossing a cell crosses each octant with \
+         chance 1/4), for rays that cross the scene's box, ignoring that rays stop at their \
+         first hit: an upper bound, good for comparing settings",
+    );
+    if let Some((p, kind)) = prediction(info) {
+        ui.label(format!(
+            "Predicted {kind}: {:.2} s (build + render {:.2} s)",
+            p.render_s,
+            info.build_seconds + p.render_s
+        ));
+    }
+    ui.horizontal(|ui| {
+        let running = info.suggestion.is_some_and(|s| s.result().is_none());
+        let can_suggest = info.unit_costs.is_some() && info.last_pass.is_some() && !running;
+        if ui
+            .add_enabled(can_suggest, egui::Button::new("Suggest a setting"))
+            .on_hover_text(
+                "build the tree at max depths 4-12 and leaf sizes 1-16 (renders nothing) and \
+                 pick the least build + predicted render time",
+            )
+            .clicked()
+        {
+            commands.push(Command::SuggestOctree);
+        }
+        if running {
+            ui.spinner();
+            ui.label("building 25 trees");
+        }
+    });
+    if let Some(Some(best)) = info.suggestion.and_then(|s| s.result()) {
+        let p = best.params;
+        ui.horizontal(|ui| {
+            ui.label(format!(
+                "Suggested: depth {}, leaf size {} ({:.2} s predicted)",
+                p.max_depth,
+                p.leaf_size,
+                best.predicted_total_s()
+            ));
+            if ui
+                .add_enabled(p != params, egui::Button::new("Apply"))
+                .clicked()
+            {
+                commands.push(Command::SetOctreeParams(p));
+            }
+        });
+    } else if let Some(None) = info.suggestion.and_then(|s| s.result()) {
+        ui.label("No setting of the grid fits the octree's memory budget.");
+    }
+    commands
+}
