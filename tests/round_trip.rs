@@ -224,9 +224,8 @@ proptest! {
     }
 
     /// A scene saved with edits (camera, image settings, the octree switch,
-    /// lights, the file's materials) loads back with exactly those values,
-    /// in its own folder or another; edits to a mesh's MTL materials are
-    /// named as left out, and the saved file keeps the MTL's values.
+    /// lights, the file's materials and a mesh's MTL materials) loads back
+    /// with exactly those values, in its own folder or another.
     #[test]
     fn a_scene_saved_with_edits_loads_back_with_them(
         text in scene_text(),
@@ -278,18 +277,69 @@ proptest! {
         (expected.image.samples, expected.image.adaptive) = (settings.samples, settings.adaptive);
         expected.image.max_depth = max_depth;
         expected.octree_enabled = octree;
-        // The file's own materials come first; the mesh's MTL ones follow.
-        let own = text.matches("[materials.").count();
-        let mut left_out = Vec::new();
-        for (i, m) in materials.iter().enumerate() {
-            if i < own {
-                expected.materials[i] = m.clone();
-            } else if *m != loaded.materials[i] {
-                left_out.push(m.name.clone());
-            }
-        }
-        prop_assert_eq!(&saved.left_out_materials, &left_out);
+        // The file's own materials and the mesh's MTL ones alike.
+        expected.materials.clone_from(&materials);
+        prop_assert!(saved.left_out.is_empty(), "{:?}", saved.left_out);
         assert_same(&expected, &again)?;
         prop_assert_eq!(again.render_settings(), settings);
+    }
+
+    /// An NFF scene saved with edits (camera, image size, lights with and
+    /// without a colour in the file, materials given by several `f`
+    /// lines) loads back with those values; the field of view to within
+    /// rounding of NFF's angle.
+    #[test]
+    fn an_nff_scene_saved_with_edits_loads_back_with_them(
+        edits in edits_strategy(),
+        eye in vec3(number()),
+        fov in 0.5..179.0f64,
+        size in (1u32..4096, 1u32..4096),
+        ks in prop::collection::vec(0.0..=1.0f64, 2),
+    ) {
+        let text = "# SPD-like\nv\nfrom 2 1 1.5\nat 0 0 0\nup 0 0 1\nangle 45\nhither 0.01\n\
+            resolution 512 512\nb 0.1 0.3 0.7\nl 4 3 2 # uncoloured\nl 1 -4 4 0.5 0.5 0.5\n\
+            f 1 0.75 0.33 0.8 0 100 0 1\ns 0 0 0 0.5\nf 0.9 0.9 0.9 0.5 0.5 45 0.5 1.5\n\
+            c 0 0 0 1 0 0 1 0.5\nf 1 0.75 0.33 0.8 0 100 0 1\np 3\n0 0 0\n1 0 0\n0 1 0\n";
+        let path = Path::new("spd/scene.nff");
+        let files = Files { scene: String::new(), obj: Vec::new(), mtl: Vec::new() };
+        let loaded = glint::scene::load_str(text, path, &files).unwrap();
+        let mut camera = loaded.camera;
+        camera.eye = DVec3::from(eye);
+        camera.fov = fov;
+        if camera.check().is_err() {
+            return Err(TestCaseError::reject("camera"));
+        }
+        let mut settings = loaded.render_settings();
+        (settings.width, settings.height) = size;
+        let lights: Vec<Light> = edits.0.iter().take(2).map(|(p, c)| Light { position: *p, color: *c }).collect();
+        // What NFF can say: ka follows kd, reflectivity follows ks.
+        let materials: Vec<Material> = loaded.materials.iter().zip(&edits.1).zip(&ks).map(|((m, (c, kd, n)), ks)| Material {
+            color: *c, kd: *kd, ka: *kd, ks: *ks, reflectivity: *ks, shininess: *n, ..m.clone()
+        }).collect();
+        if materials[0] == materials[1] {
+            return Err(TestCaseError::reject("materials made equal merge"));
+        }
+        let request = glint::scene::save::SaveRequest {
+            loaded: &loaded,
+            loaded_path: path,
+            camera: &camera,
+            lights: &lights,
+            materials: &materials,
+            settings: &settings,
+            mesh_paths: glint::scene::save::MeshPaths::Anchored,
+        };
+        let saved = glint::scene::save::scene_nff(&request).unwrap();
+        prop_assert!(saved.left_out.is_empty(), "{:?}", saved.left_out);
+        prop_assert!(saved.text.contains("# uncoloured"));
+        let again = glint::scene::load_str(&saved.text, path, &files)
+            .map_err(|e| TestCaseError::fail(format!("{e}\n{}", saved.text)))?;
+        prop_assert!((again.camera.fov - fov).abs() <= 1e-9 * fov, "{} {}", again.camera.fov, fov);
+        let mut expected = loaded.clone();
+        expected.camera = camera;
+        expected.camera.fov = again.camera.fov;
+        expected.lights = lights;
+        expected.materials = materials;
+        (expected.image.width, expected.image.height) = size;
+        assert_same(&expected, &again)?;
     }
 }

@@ -668,6 +668,67 @@ fn edits_undo_redo_save_and_a_reload_that_asks() {
     assert!(!h.state().unsaved());
 }
 
+/// An NFF scene is saved in place as NFF: its comments kept, the edits
+/// in; what NFF cannot say (a reflectivity apart from Ks) is named and
+/// stays marked unsaved.
+#[test]
+fn an_nff_scene_is_saved_as_nff_and_what_it_cannot_hold_stays_unsaved() {
+    use egui::{Key, Modifiers};
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("balls.nff");
+    let text = "# two balls\nv\nfrom 0 -4 1\nat 0 0 0\nup 0 0 1\nangle 40\nhither 0.01\n\
+                resolution 64 48\nb 0.1 0.2 0.3\nl 4 -3 5\n\
+                f 1 0.5 0.2 0.7 0.3 20 0 1\ns 0 0 0 1\ns 1 0 0 0.5\n";
+    std::fs::write(&path, text).unwrap();
+    let mut h = harness(app_at(&path));
+    settle(&mut h);
+    h.state_mut().camera_mut().fov = 35.0;
+    h.state_mut().scene_mut().lights[0].color = glint::math::DVec3::new(0.9, 0.8, 0.7);
+    h.state_mut().scene_mut().materials[0].color = glint::math::DVec3::new(0.2, 0.4, 0.6);
+    h.run_steps(2);
+    assert!(h.state().unsaved());
+    press(&mut h, Modifiers::COMMAND, Key::S);
+    assert!(!h.state().unsaved(), "{:?}", h.state().messages().last());
+    let written = std::fs::read_to_string(&path).unwrap();
+    assert!(written.starts_with("# two balls\n"), "{written}");
+    assert!(written.contains("l 4 -3 5 0.9 0.8 0.7\n"), "{written}");
+    let saved = glint::scene::load(&path).unwrap();
+    assert!((saved.camera.fov - 35.0).abs() < 1e-12);
+    assert_eq!(saved.materials, h.state().scene().materials);
+
+    h.state_mut().scene_mut().materials[0].reflectivity = 0.05;
+    h.run_steps(2);
+    press(&mut h, Modifiers::COMMAND, Key::S);
+    let message = &h.state().messages().last().unwrap().text;
+    assert!(message.contains("the reflectivity of f1"), "{message}");
+    assert!(h.state().unsaved(), "the reflectivity is not in the file");
+}
+
+/// An OBJ opened on its own, its MTL material edited: "Save as" writes
+/// a TOML scene that holds the edit (in the mesh object's `materials`).
+#[test]
+fn edits_to_an_objs_mtl_materials_are_saved() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(app_for("assets/cornell_box/cornell_box.obj", 48, 48));
+    settle(&mut h);
+    let i = h
+        .state()
+        .scene()
+        .materials
+        .iter()
+        .position(|m| m.name == "red")
+        .expect("the Cornell box's red wall");
+    h.state_mut().scene_mut().materials[i].color = glint::math::DVec3::new(0.1, 0.2, 0.9);
+    h.run_steps(2);
+    let path = dir.path().join("box.toml");
+    h.state_mut().save_to(&path);
+    assert!(!h.state().unsaved(), "{:?}", h.state().messages().last());
+    let saved = glint::scene::load(&path).unwrap();
+    assert_eq!(saved.materials, h.state().scene().materials);
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(text.contains("[objects.materials.red]"), "{text}");
+}
+
 /// The built-in scene has no file: Save writes a new TOML scene (with the
 /// bunny beside it) that loads to the same scene.
 #[test]

@@ -199,13 +199,13 @@ pub(super) fn read_libraries(
 /// The scene's material index for each of `mesh`'s `usemtl` slots: its
 /// libraries' materials, added to the scene once each (named after the
 /// MTL, made unique), and the default material for faces with none or
-/// with a name no library defines.
+/// with a name no library defines (returned too, if any face uses it).
 pub(super) fn mesh_materials(
     scene: &mut Scene,
     mesh: &LoadedMesh,
     mesh_path: &Path,
     files: &dyn MeshSource,
-) -> Vec<u32> {
+) -> (Vec<u32>, Option<u32>) {
     let entries = read_libraries(&mesh.libraries, mesh_path, files, &mut scene.load_notes);
     for (k, n) in mtl::not_rendered(&entries) {
         *scene.not_rendered.entry(k).or_default() += n;
@@ -256,7 +256,30 @@ pub(super) fn mesh_materials(
         };
         slots.push(index);
     }
-    slots
+    (slots, default)
+}
+
+/// Each scene material `mesh_materials` gave `mesh`, once, with the name a
+/// scene file uses for it: its MTL name, or `default` for faces with none
+/// or with a name no library defines.
+pub(super) fn slot_names(
+    mesh: &LoadedMesh,
+    slots: &[u32],
+    default: Option<u32>,
+) -> Vec<(u32, String)> {
+    let mut names: Vec<(u32, String)> = Vec::new();
+    for (slot, &index) in slots.iter().enumerate() {
+        if index == u32::MAX || names.iter().any(|(i, _)| *i == index) {
+            continue;
+        }
+        let name = if Some(index) == default {
+            "default".to_owned()
+        } else {
+            mesh.material_names[slot].clone()
+        };
+        names.push((index, name));
+    }
+    names
 }
 
 /// Area-weighted vertex normals for a triangle soup, vertices matched by

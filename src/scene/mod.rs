@@ -17,7 +17,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 pub use mesh::{FileSystem, MeshSource};
-pub use model::{ImageSettings, Location, Scene, SceneError};
+pub use model::{ImageSettings, Location, MeshMaterialOrigin, Scene, SceneError};
 pub use obj::SkippedElements;
 pub use polygon::DroppedPolygons;
 

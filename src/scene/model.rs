@@ -90,6 +90,21 @@ pub struct Scene {
     /// The text the scene was parsed from, kept for reproducible exports
     /// (empty for scenes built in code).
     pub source_text: Arc<str>,
+    /// Which materials a TOML scene's meshes brought from their MTL files:
+    /// "Save scene" writes edits to them into the mesh object.
+    pub mesh_material_origins: Vec<MeshMaterialOrigin>,
+}
+
+/// A material a mesh object of a TOML scene took from its own file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshMaterialOrigin {
+    /// Index into [`Scene::materials`].
+    pub material: u32,
+    /// Index of the object in the file's `objects`.
+    pub object: usize,
+    /// Its name in the mesh's MTL file (`default` for faces with none),
+    /// the key under the object's `materials`.
+    pub name: String,
 }
 
 impl Scene {
@@ -132,6 +147,7 @@ impl Scene {
             load_notes: Vec::new(),
             color_values: ColorConvention::Linear,
             source_text: Arc::from(""),
+            mesh_material_origins: Vec::new(),
         }
     }
 

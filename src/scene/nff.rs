@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use std::ops::RangeInclusive;
+use std::ops::{Range, RangeInclusive};
 
 use super::model::{ImageSettings, Location, Scene, SceneError};
 use crate::camera::CameraSpec;
@@ -24,6 +24,8 @@ struct Token<'a> {
     text: &'a str,
     line: usize,
     column: usize,
+    /// Byte offset in the file's text.
+    offset: usize,
 }
 
 struct Tokens<'a> {
@@ -48,6 +50,8 @@ impl<'a> Tokens<'a> {
                     text: &tail[..len],
                     line: l + 1,
                     column: line[..offset].chars().count() + 1,
+                    // `tail` is a slice of `text`.
+                    offset: tail.as_ptr() as usize - text.as_ptr() as usize,
                 });
                 rest = &tail[len..];
             }
@@ -133,6 +137,14 @@ impl<'a> Tokens<'a> {
             .map_err(|e| self.error_at(line, column, self.entity.2, format!("{what}: {e}")))
     }
 
+    /// Byte ranges of the last `N` tokens read.
+    fn last<const N: usize>(&self) -> [Range<usize>; N] {
+        std::array::from_fn(|k| {
+            let t = &self.tokens[self.next - N + k];
+            t.offset..t.offset + t.text.len()
+        })
+    }
+
     /// Line and column of the next token (or of the entity, at the end).
     fn peek_place(&self) -> (usize, usize) {
         self.tokens
@@ -183,7 +195,63 @@ pub fn fov_from_nff_angle(angle_degrees: f64, rows: u32) -> f64 {
     2.0 * half.atan().to_degrees()
 }
 
+/// Where the numbers the viewer edits stand in an NFF file (byte ranges of
+/// its text), so that "Save scene" rewrites those and keeps the rest.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct NffLayout {
+    /// The viewpoint's `from`, `at` and `up` vectors, `angle` and
+    /// `resolution`.
+    pub view: Option<ViewLayout>,
+    /// Each light's position, and its colour if the file gives one
+    /// (otherwise where one would go: right after the position).
+    pub lights: Vec<LightLayout>,
+    /// For each scene material, every `f` entity that gives it: colour,
+    /// Kd, Ks, Shine, T and index of refraction.
+    pub materials: Vec<Vec<[Range<usize>; 8]>>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct ViewLayout {
+    pub from: [Range<usize>; 3],
+    pub at: [Range<usize>; 3],
+    pub up: [Range<usize>; 3],
+    pub angle: Range<usize>,
+    pub resolution: [Range<usize>; 2],
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightLayout {
+    pub position: [Range<usize>; 3],
+    pub color: Option<[Range<usize>; 3]>,
+}
+
+/// The NFF file's layout; errors as [`parse`] gives them.
+pub fn layout(text: &str, path: &Path) -> Result<NffLayout, SceneError> {
+    let mut layout = NffLayout::default();
+    parse_into(text, path, Some(&mut layout))?;
+    Ok(layout)
+}
+
+/// NFF's `angle` (between the centres of the first and last of `rows`
+/// pixel rows) for a vertical field of view: the inverse of
+/// [`fov_from_nff_angle`].
+pub fn nff_angle_from_fov(fov_degrees: f64, rows: u32) -> f64 {
+    if rows <= 1 {
+        return fov_degrees;
+    }
+    let half = (fov_degrees.to_radians() * 0.5).tan() * (rows - 1) as f64 / rows as f64;
+    2.0 * half.atan().to_degrees()
+}
+
 pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
+    parse_into(text, path, None)
+}
+
+fn parse_into(
+    text: &str,
+    path: &Path,
+    mut layout: Option<&mut NffLayout>,
+) -> Result<Scene, SceneError> {
     let mut tokens = Tokens::new(text, path);
     let mut camera: Option<CameraSpec> = None;
     // NFF colours are display values: the SPD's pictures were shaded and
@@ -229,18 +297,31 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
             "v" => {
                 tokens.label("from")?;
                 let eye = tokens.vec3("from")?;
+                let from_at = tokens.last();
                 tokens.label("at")?;
                 let lookat = tokens.vec3("at")?;
+                let at_at = tokens.last();
                 tokens.label("up")?;
                 let up = tokens.vec3("up")?;
+                let up_at = tokens.last();
                 tokens.label("angle")?;
                 let angle = tokens.number("angle")?;
+                let [angle_at] = tokens.last();
                 tokens.label("hither")?;
                 let _hither = tokens.number("hither")?;
                 tokens.label("resolution")?;
                 let limit = MAX_IMAGE_SIDE as usize;
                 let w = tokens.count("resolution", limit)?;
                 let h = tokens.count("resolution", limit)?;
+                if let Some(layout) = layout.as_deref_mut() {
+                    layout.view = Some(ViewLayout {
+                        from: from_at,
+                        at: at_at,
+                        up: up_at,
+                        angle: angle_at,
+                        resolution: tokens.last(),
+                    });
+                }
                 if w == 0 || h == 0 {
                     return Err(tokens.error_at(
                         line,
@@ -273,13 +354,23 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
             "b" => image.background = tokens.color_in("background colour", &UNIT_RANGE)?,
             "l" => {
                 let position = tokens.vec3("light position")?;
+                let position_at = tokens.last();
                 // The colour is optional: it is present if the next token is a number.
                 let has_colour = tokens
                     .tokens
                     .get(tokens.next)
                     .is_some_and(|t| t.text.parse::<f64>().is_ok());
+                if let Some(layout) = layout.as_deref_mut() {
+                    layout.lights.push(LightLayout {
+                        position: position_at,
+                        color: None,
+                    });
+                }
                 if has_colour {
                     let color = tokens.color_in("light colour", &INTENSITY_RANGE)?;
+                    if let Some(light) = layout.as_deref_mut().and_then(|l| l.lights.last_mut()) {
+                        light.color = Some(tokens.last());
+                    }
                     scene.lights.push(Light { position, color });
                 } else {
                     uncoloured_lights.push(scene.lights.len());
@@ -321,13 +412,18 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
                     (o.color, o.kd, o.ks, o.shininess, o.transparency, o.ior)
                         == (m.color, m.kd, m.ks, m.shininess, m.transparency, m.ior)
                 };
-                material = Some(match scene.materials.iter().position(same) {
-                    Some(i) => i as u32,
+                let index = match scene.materials.iter().position(same) {
+                    Some(i) => i,
                     None => {
                         scene.materials.push(m);
-                        (scene.materials.len() - 1) as u32
+                        scene.materials.len() - 1
                     }
-                });
+                };
+                if let Some(layout) = layout.as_deref_mut() {
+                    layout.materials.resize(scene.materials.len(), Vec::new());
+                    layout.materials[index].push(tokens.last());
+                }
+                material = Some(index as u32);
             }
             "s" => {
                 let center = tokens.vec3("sphere centre")?;

@@ -3,11 +3,12 @@
 //! every number nobody changed stay as they were; only values that differ
 //! from the scene as loaded are written.
 
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use toml_edit::{Array, DocumentMut, Item, TableLike, Value};
 
-use super::Scene;
+use super::{MeshMaterialOrigin, Scene};
 use crate::camera::CameraSpec;
 use crate::material::{Light, Material};
 use crate::math::DVec3;
@@ -17,9 +18,11 @@ use crate::settings::{Protocol, RenderSettings};
 #[derive(Debug, thiserror::Error)]
 pub enum SaveError {
     #[error(
-        "{path} is an NFF scene: glint saves TOML scenes only (export a PNG to keep these edits; `glint render --from-png` renders it again)"
+        "{path} is an NFF scene: it is saved as NFF (name the file .nff); TOML has no cones or polygons"
     )]
     NotToml { path: PathBuf },
+    #[error("{path} is not an NFF scene: it is saved as TOML (name the file .toml)")]
+    NotNff { path: PathBuf },
     #[error("the scene text of {path} is not TOML glint can edit: {message}")]
     Unreadable { path: PathBuf, message: String },
     #[error("the edited scene has {edited} lights where its file has {loaded}")]
@@ -61,9 +64,9 @@ pub struct SaveRequest<'a> {
 #[derive(Clone, Debug, PartialEq)]
 pub struct SavedText {
     pub text: String,
-    /// Edited materials a mesh's MTL file defines: a TOML scene takes those
-    /// from the MTL file, so the edits are not in `text`.
-    pub left_out_materials: Vec<String>,
+    /// Edits the format has no place for, each said in a few words (e.g.
+    /// "samples", "the reflectivity of f2"): they are not in `text`.
+    pub left_out: Vec<String>,
 }
 
 /// The TOML text of `request` to be written at `destination`.
@@ -95,11 +98,177 @@ pub fn scene_toml(request: &SaveRequest, destination: &Path) -> Result<SavedText
         });
     }
     write_lights(&mut doc, &loaded.lights, request.lights);
-    let left_out_materials = write_materials(&mut doc, &loaded.materials, request.materials);
+    let left_out = write_materials(
+        &mut doc,
+        &loaded.materials,
+        request.materials,
+        &loaded.mesh_material_origins,
+    );
     write_mesh_paths(&mut doc, path, destination, request.mesh_paths);
     Ok(SavedText {
         text: doc.to_string(),
-        left_out_materials,
+        left_out: left_out
+            .into_iter()
+            .map(|name| format!("material {name}"))
+            .collect(),
+    })
+}
+
+/// The NFF text of `request`: the loaded file with the numbers the viewer
+/// edits (viewpoint, resolution, lights, `f` materials) rewritten and
+/// everything else, comments included, as it was. What NFF cannot say
+/// (samples, depth, colours, sides, the octree switch, a reflectivity
+/// apart from Ks) is listed in `left_out`.
+pub fn scene_nff(request: &SaveRequest) -> Result<SavedText, SaveError> {
+    let loaded = request.loaded;
+    let path = request.loaded_path;
+    let is_nff = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("nff"));
+    if !is_nff {
+        return Err(SaveError::NotNff {
+            path: path.to_owned(),
+        });
+    }
+    let text = &*loaded.source_text;
+    let layout = super::nff::layout(text, path).map_err(|e| SaveError::Unreadable {
+        path: path.to_owned(),
+        message: e.to_string(),
+    })?;
+    if request.lights.len() != loaded.lights.len() {
+        return Err(SaveError::LightCount {
+            loaded: loaded.lights.len(),
+            edited: request.lights.len(),
+        });
+    }
+    let number = |x: f64| format!("{x:?}");
+    let mut edits: Vec<(Range<usize>, String)> = Vec::new();
+    let mut put = |ranges: &[Range<usize>], values: &[f64]| {
+        for (r, &x) in ranges.iter().zip(values) {
+            edits.push((r.clone(), number(x)));
+        }
+    };
+    let mut left_out = Vec::new();
+
+    let s = request.settings;
+    let im = &loaded.image;
+    let resize = s.protocol == Protocol::Glint && (s.width, s.height) != (im.width, im.height);
+    let rows = if resize { s.height } else { im.height };
+    if let Some(view) = &layout.view {
+        let (old, new) = (&loaded.camera, request.camera);
+        for (ranges, a, b) in [
+            (&view.from, old.eye, new.eye),
+            (&view.at, old.lookat, new.lookat),
+            (&view.up, old.up, new.up),
+        ] {
+            if a != b {
+                put(ranges, &b.to_array());
+            }
+        }
+        // NFF's angle depends on the row count; the field of view is kept.
+        if old.fov != new.fov || resize {
+            put(
+                std::slice::from_ref(&view.angle),
+                &[super::nff::nff_angle_from_fov(new.fov, rows)],
+            );
+        }
+        if resize {
+            edits.push((view.resolution[0].clone(), s.width.to_string()));
+            edits.push((view.resolution[1].clone(), s.height.to_string()));
+        }
+    }
+    if s.protocol == Protocol::Glint {
+        for (what, differs) in [
+            (
+                "samples",
+                (s.samples, s.adaptive) != (im.samples, im.adaptive),
+            ),
+            ("max depth", s.max_depth != im.max_depth),
+            ("colours", s.colors != im.colors),
+            ("sides", s.sides != im.sides),
+        ] {
+            if differs {
+                left_out.push(what.to_owned());
+            }
+        }
+    }
+    if s.use_octree != loaded.octree_enabled {
+        left_out.push("the octree switch".to_owned());
+    }
+
+    for ((place, old), new) in layout.lights.iter().zip(&loaded.lights).zip(request.lights) {
+        let mut put = |ranges: &[Range<usize>], values: &[f64]| {
+            for (r, &x) in ranges.iter().zip(values) {
+                edits.push((r.clone(), number(x)));
+            }
+        };
+        if old.position != new.position {
+            put(&place.position, &new.position.to_array());
+        }
+        if old.color != new.color {
+            match &place.color {
+                Some(ranges) => put(ranges, &new.color.to_array()),
+                None => {
+                    let end = place.position[2].end;
+                    let c = new.color;
+                    edits.push((
+                        end..end,
+                        format!(" {} {} {}", number(c.x), number(c.y), number(c.z)),
+                    ));
+                }
+            }
+        }
+    }
+
+    for (i, (old, new)) in loaded.materials.iter().zip(request.materials).enumerate() {
+        if old == new {
+            continue;
+        }
+        // NFF has one coefficient for the highlight and the mirror ray, and
+        // weights the ambient term by Kd.
+        if new.reflectivity != new.ks {
+            left_out.push(format!("the reflectivity of {} (NFF uses Ks)", old.name));
+        }
+        let values = [
+            new.color.x,
+            new.color.y,
+            new.color.z,
+            new.kd,
+            new.ks,
+            new.shininess,
+            new.transparency,
+            new.ior,
+        ];
+        for entity in layout.materials.get(i).into_iter().flatten() {
+            for (r, (&a, &b)) in entity.iter().zip(values.iter().zip(&[
+                old.color.x,
+                old.color.y,
+                old.color.z,
+                old.kd,
+                old.ks,
+                old.shininess,
+                old.transparency,
+                old.ior,
+            ])) {
+                if a != b {
+                    edits.push((r.clone(), number(a)));
+                }
+            }
+        }
+    }
+
+    edits.sort_by_key(|(r, _)| (r.start, r.end));
+    let mut out = String::with_capacity(text.len() + 64 * edits.len());
+    let mut at = 0;
+    for (r, new) in edits {
+        out.push_str(&text[at..r.start]);
+        out.push_str(&new);
+        at = r.end;
+    }
+    out.push_str(&text[at..]);
+    Ok(SavedText {
+        text: out,
+        left_out,
     })
 }
 
@@ -238,44 +407,75 @@ fn write_lights(doc: &mut DocumentMut, loaded: &[Light], lights: &[Light]) {
     }
 }
 
-/// Writes the file's own materials; returns the names of edited ones that
-/// come from a mesh's MTL file.
+/// Writes edited materials: the file's own into `[materials]`, a mesh's
+/// MTL materials into its object's `materials`. Returns the names of any
+/// it has no place for.
 fn write_materials(
     doc: &mut DocumentMut,
     loaded: &[Material],
     materials: &[Material],
+    origins: &[MeshMaterialOrigin],
 ) -> Vec<String> {
     let mut left_out = Vec::new();
-    for (old, new) in loaded.iter().zip(materials) {
+    for (index, (old, new)) in loaded.iter().zip(materials).enumerate() {
         if old == new {
             continue;
         }
-        let entry = doc
-            .get_mut("materials")
-            .and_then(Item::as_table_like_mut)
-            .and_then(|t| t.get_mut(&old.name))
-            .and_then(Item::as_table_like_mut);
-        let Some(t) = entry else {
-            left_out.push(old.name.clone());
-            continue;
+        let origin = origins.iter().find(|o| o.material as usize == index);
+        let written = match origin {
+            Some(o) => mesh_material_table(doc, o).map(|t| write_material(t, old, new)),
+            None => doc
+                .get_mut("materials")
+                .and_then(Item::as_table_like_mut)
+                .and_then(|t| t.get_mut(&old.name))
+                .and_then(Item::as_table_like_mut)
+                .map(|t| write_material(t, old, new)),
         };
-        if old.color != new.color {
-            set(t, "color", vec3(new.color));
-        }
-        for (key, a, b) in [
-            ("kd", old.kd, new.kd),
-            ("ks", old.ks, new.ks),
-            ("shininess", old.shininess, new.shininess),
-            ("reflectivity", old.reflectivity, new.reflectivity),
-            ("transparency", old.transparency, new.transparency),
-            ("ior", old.ior, new.ior),
-        ] {
-            if a != b {
-                set(t, key, Value::from(b));
-            }
+        if written.is_none() {
+            left_out.push(old.name.clone());
         }
     }
     left_out
+}
+
+/// The table `objects[k].materials.NAME` of a mesh material, made if the
+/// file has none.
+fn mesh_material_table<'d>(
+    doc: &'d mut DocumentMut,
+    origin: &MeshMaterialOrigin,
+) -> Option<&'d mut dyn TableLike> {
+    let object = tables_of(doc.get_mut("objects")?)
+        .into_iter()
+        .nth(origin.object)?;
+    let materials = object.entry("materials").or_insert_with(|| {
+        let mut t = toml_edit::Table::new();
+        // Only `[objects.materials.NAME]` headers are written.
+        t.set_implicit(true);
+        Item::Table(t)
+    });
+    materials
+        .as_table_like_mut()?
+        .entry(&origin.name)
+        .or_insert_with(toml_edit::table)
+        .as_table_like_mut()
+}
+
+fn write_material(t: &mut dyn TableLike, old: &Material, new: &Material) {
+    if old.color != new.color {
+        set(t, "color", vec3(new.color));
+    }
+    for (key, a, b) in [
+        ("kd", old.kd, new.kd),
+        ("ks", old.ks, new.ks),
+        ("shininess", old.shininess, new.shininess),
+        ("reflectivity", old.reflectivity, new.reflectivity),
+        ("transparency", old.transparency, new.transparency),
+        ("ior", old.ior, new.ior),
+    ] {
+        if a != b {
+            set(t, key, Value::from(b));
+        }
+    }
 }
 
 /// Rewrites relative mesh paths so the saved file finds the same meshes.
@@ -327,6 +527,7 @@ fn folder(file: &Path) -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::material::Light;
     use crate::scene::{MeshSource, load_str};
 
     struct NoMeshes;
@@ -372,7 +573,7 @@ mod tests {
         )
         .unwrap();
         assert_eq!(saved.text, TEXT);
-        assert!(saved.left_out_materials.is_empty());
+        assert!(saved.left_out.is_empty());
     }
 
     #[test]
@@ -416,8 +617,218 @@ mod tests {
         assert_eq!((again.image.samples, again.image.adaptive), (16, true));
     }
 
+    /// An OBJ and its MTL, from memory.
+    struct Model;
+    impl MeshSource for Model {
+        fn read(&self, path: &Path) -> std::io::Result<Vec<u8>> {
+            let text = match path.file_name().and_then(|n| n.to_str()) {
+                Some("m.obj") => {
+                    "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n\
+                     usemtl red\nf 1 2 3\nusemtl white\nf 2 4 3\nusemtl nowhere\nf 1 2 4\n"
+                }
+                Some("m.mtl") => "newmtl red\nKd 0.8 0.1 0.1\nnewmtl white\nKd 0.9 0.9 0.9\n",
+                _ => return Err(std::io::ErrorKind::NotFound.into()),
+            };
+            Ok(text.as_bytes().to_vec())
+        }
+    }
+
     #[test]
-    fn nff_scenes_are_refused_with_the_way_to_keep_the_edits() {
+    fn edits_to_a_meshs_own_materials_are_written_into_its_object() {
+        // One object in an array of tables, one in an inline array, so both
+        // TOML forms are covered; the second mesh's materials get new names.
+        for objects in [
+            "[[objects]]\nkind = \"mesh\"\npath = \"m.obj\" # the model\n\n\
+             [[objects]]\nkind = \"mesh\"\npath = \"m.obj\"\ntranslate = [2, 0, 0]\n",
+            "objects = [{ kind = \"mesh\", path = \"m.obj\" }, \
+             { kind = \"mesh\", path = \"m.obj\", translate = [2, 0, 0] }]\n",
+        ] {
+            // An inline array must come before the first table header.
+            let camera =
+                "[camera]\neye = [0, 0, 5]\nlookat = [0, 0, 0]\nup = [0, 1, 0]\nfov = 40\n";
+            let text = if objects.starts_with("[[") {
+                format!("{camera}{objects}")
+            } else {
+                format!("{objects}{camera}")
+            };
+            let path = Path::new("dir/scene.toml");
+            let loaded = load_str(&text, path, &Model).unwrap();
+            let names: Vec<&str> = loaded.materials.iter().map(|m| m.name.as_str()).collect();
+            assert_eq!(
+                names,
+                [
+                    "red",
+                    "white",
+                    "default",
+                    "red (2)",
+                    "white (2)",
+                    "default (2)"
+                ]
+            );
+            let settings = loaded.render_settings();
+            let mut materials = loaded.materials.clone();
+            // The second mesh's white, and the first mesh's default.
+            materials[4].color = DVec3::new(0.25, 0.5, 0.75);
+            materials[4].reflectivity = 0.5;
+            materials[2].kd = 0.125;
+            let req = SaveRequest {
+                materials: &materials,
+                ..request(&loaded, &loaded.camera, &settings)
+            };
+            let saved = scene_toml(&req, path).unwrap();
+            assert!(saved.left_out.is_empty(), "{saved:?}");
+            let again = load_str(&saved.text, path, &Model).unwrap_or_else(|e| {
+                panic!("{e}\n{}", saved.text);
+            });
+            assert_eq!(again.materials, materials, "{}", saved.text);
+            assert_eq!(again.shape_materials, loaded.shape_materials);
+            if objects.starts_with("[[") {
+                assert!(saved.text.contains("# the model"), "{}", saved.text);
+                assert!(
+                    saved.text.contains("[objects.materials.white]"),
+                    "{}",
+                    saved.text
+                );
+            }
+            // Saving the saved scene unchanged changes nothing.
+            let req = SaveRequest {
+                materials: &again.materials,
+                ..request(&again, &again.camera, &settings)
+            };
+            assert_eq!(scene_toml(&req, path).unwrap().text, saved.text);
+        }
+    }
+
+    #[test]
+    fn mesh_material_keys_are_checked() {
+        let head = "[camera]\neye = [0, 0, 5]\nlookat = [0, 0, 0]\nup = [0, 1, 0]\nfov = 40\n\
+                    [[objects]]\nkind = \"mesh\"\npath = \"m.obj\"\n";
+        let error = |tail: &str| {
+            load_str(&format!("{head}{tail}"), Path::new("s.toml"), &Model)
+                .unwrap_err()
+                .to_string()
+        };
+        let e = error("[objects.materials.blue]\nkd = 0.5\n");
+        assert!(
+            e.contains("s.toml:9:20: `objects[0].materials`: the mesh's faces use no material `blue` (they use: red, white, default)"),
+            "{e}"
+        );
+        let e = error("[objects.materials.red]\nkd = 2\n");
+        assert!(
+            e.contains("s.toml:10:6: `objects[0].materials.red.kd`"),
+            "{e}"
+        );
+        let e = error("material = \"x\"\n");
+        assert!(e.contains("no material named `x`"), "{e}");
+    }
+
+    const NFF: &str = "# balls, cut down\nv\nfrom 2.1 1.3 1.7\nat 0 0 0.2\nup 0 0 1\n\
+        angle 45\nhither 0.01\nresolution 512 512\nb 0.078 0.361 0.753\n\
+        l 4 3 2   # key\nl 1 -4 4 0.5 0.5 0.5\n\
+        f 1 0.75 0.33 0.8 0 100000 0 1\ns 0 0 0 0.5\n\
+        f 1 0.9 0.7 0 0.5 45.2776 0 0\ns 0.27 0.27 0.27 0.16\n\
+        f 1 0.75 0.33 0.8 0 100000 0 1\ns 0 0.5 0 0.1\n";
+
+    fn nff_request<'a>(
+        loaded: &'a Scene,
+        camera: &'a CameraSpec,
+        settings: &'a RenderSettings,
+        lights: &'a [Light],
+        materials: &'a [Material],
+    ) -> SaveRequest<'a> {
+        SaveRequest {
+            loaded,
+            loaded_path: Path::new("dir/balls.nff"),
+            camera,
+            lights,
+            materials,
+            settings,
+            mesh_paths: MeshPaths::Anchored,
+        }
+    }
+
+    #[test]
+    fn an_nff_scene_is_saved_as_nff_with_its_edits_and_comments() {
+        let path = Path::new("dir/balls.nff");
+        let loaded = load_str(NFF, path, &NoMeshes).unwrap();
+        let settings = loaded.render_settings();
+        let unedited = scene_toml(
+            &request(&loaded, &loaded.camera, &settings),
+            Path::new("x.toml"),
+        );
+        assert!(unedited.is_err(), "an NFF scene saved as TOML");
+        let same = scene_nff(&nff_request(
+            &loaded,
+            &loaded.camera,
+            &settings,
+            &loaded.lights,
+            &loaded.materials,
+        ))
+        .unwrap();
+        assert_eq!(same.text, NFF);
+        assert!(same.left_out.is_empty());
+
+        let mut camera = loaded.camera;
+        camera.eye = DVec3::new(1e100, -2.5e-300, 0.1);
+        camera.fov = 12.5;
+        let mut settings = loaded.render_settings();
+        (settings.width, settings.height) = (300, 200);
+        settings.samples = 16;
+        let mut lights = loaded.lights.clone();
+        lights[0].color = DVec3::new(0.25, 0.5, 2.0);
+        lights[1].position = DVec3::new(-1.0, 0.0, 7.5);
+        let mut materials = loaded.materials.clone();
+        materials[0].color = DVec3::new(0.1, 0.2, 0.3);
+        materials[0].kd = 0.5;
+        materials[0].ka = 0.5;
+        materials[1].reflectivity = 0.25;
+        let saved = scene_nff(&nff_request(
+            &loaded, &camera, &settings, &lights, &materials,
+        ))
+        .unwrap();
+        let text = &saved.text;
+        for kept in [
+            "# balls, cut down\n",
+            "at 0 0 0.2\n",
+            "l 4 3 2 0.25 0.5 2.0   # key\n",
+            "hither 0.01\n",
+            "resolution 300 200\n",
+        ] {
+            assert!(text.contains(kept), "lost {kept:?} in\n{text}");
+        }
+        assert_eq!(
+            saved.left_out,
+            ["samples", "the reflectivity of f2 (NFF uses Ks)"]
+        );
+        let again = load_str(text, path, &NoMeshes).unwrap();
+        assert_eq!(again.camera.eye, camera.eye);
+        assert!(
+            (again.camera.fov - camera.fov).abs() < 1e-12,
+            "{}",
+            again.camera.fov
+        );
+        assert_eq!((again.image.width, again.image.height), (300, 200));
+        assert_eq!(again.lights, lights);
+        // Both `f` lines of the first material changed.
+        assert_eq!(again.materials.len(), 2);
+        assert_eq!(again.materials[0], materials[0]);
+        assert_eq!(again.materials[1], loaded.materials[1]);
+        assert_eq!(again.shape_materials, loaded.shape_materials);
+    }
+
+    #[test]
+    fn nff_angles_and_fields_of_view_convert_both_ways() {
+        for rows in [1, 2, 3, 48, 512, 32768] {
+            for fov in [0.001, 1.0, 45.0, 90.0, 150.0, 179.9] {
+                let angle = crate::scene::nff::nff_angle_from_fov(fov, rows);
+                let back = crate::scene::nff::fov_from_nff_angle(angle, rows);
+                assert!((back - fov).abs() <= 1e-12 * fov, "{rows} {fov} {back}");
+            }
+        }
+    }
+
+    #[test]
+    fn nff_scenes_are_not_saved_as_toml() {
         let loaded = scene(TEXT);
         let settings = loaded.render_settings();
         let req = SaveRequest {
@@ -426,7 +837,7 @@ mod tests {
         };
         let e = scene_toml(&req, Path::new("balls.toml")).unwrap_err();
         assert!(matches!(e, SaveError::NotToml { .. }), "{e}");
-        assert!(e.to_string().contains("export a PNG"), "{e}");
+        assert!(e.to_string().contains("name the file .nff"), "{e}");
     }
 
     #[test]

@@ -116,6 +116,9 @@ struct ObjectFile {
     rotate: Option<Vec3>,
     translate: Option<Vec3>,
     smooth: Option<Spanned<bool>>,
+    /// A mesh's own (MTL) materials changed key by key, by their MTL names:
+    /// what the viewer's "Save scene" writes for edits to them.
+    materials: Option<Spanned<BTreeMap<Spanned<String>, MaterialFile>>>,
 }
 
 struct Context<'a> {
@@ -180,6 +183,47 @@ impl Context<'_> {
     ) -> Result<f64, SceneError> {
         let x = self.finite(v, key)?;
         check_range(x, range).map_err(|e| self.error(v.span(), key, e))
+    }
+
+    /// `base` with the keys `m` gives; `prefix` names the table in errors.
+    fn material(
+        &self,
+        mut mat: Material,
+        m: &MaterialFile,
+        prefix: &str,
+    ) -> Result<Material, SceneError> {
+        let key = |k: &str| format!("{prefix}.{k}");
+        if let Some(v) = &m.color {
+            mat.color = self.color(v, &key("color"), &UNIT_RANGE)?;
+        }
+        for (slot, value, k, range) in [
+            (&mut mat.kd, &m.kd, "kd", &UNIT_RANGE),
+            (&mut mat.ks, &m.ks, "ks", &UNIT_RANGE),
+            (
+                &mut mat.shininess,
+                &m.shininess,
+                "shininess",
+                &SHININESS_RANGE,
+            ),
+            (
+                &mut mat.reflectivity,
+                &m.reflectivity,
+                "reflectivity",
+                &UNIT_RANGE,
+            ),
+            (
+                &mut mat.transparency,
+                &m.transparency,
+                "transparency",
+                &UNIT_RANGE,
+            ),
+            (&mut mat.ior, &m.ior, "ior", &IOR_RANGE),
+        ] {
+            if let Some(v) = value {
+                *slot = self.in_range(v, &key(k), range)?;
+            }
+        }
+        Ok(mat)
     }
 
     fn integer(&self, v: &Spanned<i64>, key: &str, range: Range<i64>) -> Result<u32, SceneError> {
@@ -327,42 +371,11 @@ pub fn parse(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, S
 
     let mut materials = Vec::new();
     for (name, m) in &file.materials {
-        let key = |k: &str| format!("materials.{name}.{k}");
-        let mut mat = Material {
+        let base = Material {
             name: name.clone(),
             ..Material::default()
         };
-        if let Some(v) = &m.color {
-            mat.color = cx.color(v, &key("color"), &UNIT_RANGE)?;
-        }
-        for (slot, value, k, range) in [
-            (&mut mat.kd, &m.kd, "kd", &UNIT_RANGE),
-            (&mut mat.ks, &m.ks, "ks", &UNIT_RANGE),
-            (
-                &mut mat.shininess,
-                &m.shininess,
-                "shininess",
-                &SHININESS_RANGE,
-            ),
-            (
-                &mut mat.reflectivity,
-                &m.reflectivity,
-                "reflectivity",
-                &UNIT_RANGE,
-            ),
-            (
-                &mut mat.transparency,
-                &m.transparency,
-                "transparency",
-                &UNIT_RANGE,
-            ),
-            (&mut mat.ior, &m.ior, "ior", &IOR_RANGE),
-        ] {
-            if let Some(v) = value {
-                *slot = cx.in_range(v, &key(k), range)?;
-            }
-        }
-        materials.push(mat);
+        materials.push(cx.material(base, m, &format!("materials.{name}"))?);
     }
 
     let mut lights = Vec::new();
@@ -441,7 +454,14 @@ fn add_object(
         "plane" => &["point", "normal"],
         "triangle" => &["vertices"],
         "quadric" => &["coefficients", "clip"],
-        "mesh" => &["path", "scale", "rotate", "translate", "smooth"],
+        "mesh" => &[
+            "path",
+            "scale",
+            "rotate",
+            "translate",
+            "smooth",
+            "materials",
+        ],
         _ => {
             return Err(cx.error(
                 obj.kind.span(),
@@ -452,7 +472,7 @@ fn add_object(
             ));
         }
     };
-    let present: [(&str, Option<Range<usize>>); 12] = [
+    let present: [(&str, Option<Range<usize>>); 13] = [
         ("center", obj.center.as_ref().map(Spanned::span)),
         ("radius", obj.radius.as_ref().map(Spanned::span)),
         ("point", obj.point.as_ref().map(Spanned::span)),
@@ -465,6 +485,7 @@ fn add_object(
         ("rotate", obj.rotate.as_ref().map(Spanned::span)),
         ("translate", obj.translate.as_ref().map(Spanned::span)),
         ("smooth", obj.smooth.as_ref().map(Spanned::span)),
+        ("materials", obj.materials.as_ref().map(Spanned::span)),
     ];
     for (name, span) in &present {
         if let Some(span) = span
@@ -611,9 +632,53 @@ fn add_object(
             scene.dropped_polygons.not_simple += mesh.dropped_polygons.not_simple;
             scene.skipped_elements.add(&mesh.skipped);
             if named.is_some() {
+                if let Some(m) = &obj.materials {
+                    return Err(cx.error(
+                        m.span(),
+                        &key("materials"),
+                        "`materials` changes a mesh's own materials; with `material` it has none",
+                    ));
+                }
                 scene.push_mesh(mesh.triangles, mesh.normals, |_| material);
             } else {
-                let slots = super::mesh::mesh_materials(scene, &mesh, &mesh_path, files);
+                let (slots, default) = super::mesh::mesh_materials(scene, &mesh, &mesh_path, files);
+                let origins = super::mesh::slot_names(&mesh, &slots, default);
+                if let Some(overrides) = &obj.materials {
+                    for (name, m) in overrides.get_ref() {
+                        let targets: Vec<u32> = origins
+                            .iter()
+                            .filter(|(_, n)| n == name.get_ref())
+                            .map(|&(i, _)| i)
+                            .collect();
+                        if targets.is_empty() {
+                            let known: Vec<&str> =
+                                origins.iter().map(|(_, n)| n.as_str()).collect();
+                            return Err(cx.error(
+                                name.span(),
+                                &key("materials"),
+                                format!(
+                                    "the mesh's faces use no material `{}` (they use: {})",
+                                    name.get_ref(),
+                                    known.join(", ")
+                                ),
+                            ));
+                        }
+                        let prefix = key(&format!("materials.{}", name.get_ref()));
+                        for i in targets {
+                            let base = scene.materials[i as usize].clone();
+                            scene.materials[i as usize] = cx.material(base, m, &prefix)?;
+                        }
+                    }
+                }
+                scene
+                    .mesh_material_origins
+                    .extend(origins.into_iter().map(|(material, name)| {
+                        super::model::MeshMaterialOrigin {
+                            material,
+                            object: index,
+                            name,
+                        }
+                    }));
                 let per_triangle = &mesh.triangle_materials;
                 scene.push_mesh(mesh.triangles, mesh.normals, |i| {
                     slots[per_triangle[i] as usize]

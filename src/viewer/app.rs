@@ -631,8 +631,8 @@ impl GlintApp {
         }
     }
 
-    /// Writes the edits into the scene's TOML file; a scene without one
-    /// (built in, an OBJ or NFF file) is saved as a new file.
+    /// Writes the edits into the scene's TOML or NFF file; a scene without
+    /// one (built in, an OBJ file) is saved as a new TOML file.
     pub fn save(&mut self) {
         match self.edit.source.path() {
             Some(p) if save::saves_in_place(&self.edit.source) => {
@@ -643,8 +643,8 @@ impl GlintApp {
         }
     }
 
-    /// Writes the scene with its edits to a new TOML file and goes on
-    /// editing that file.
+    /// Writes the scene with its edits to a new file (NFF for an NFF
+    /// scene, TOML otherwise) and goes on editing that file.
     pub fn save_as(&mut self) {
         if let Some(path) = save::choose_path(&self.edit.source) {
             self.save_to(&path);
@@ -665,16 +665,24 @@ impl GlintApp {
                 scene.source_text = Arc::clone(&self.edit.loaded.source_text);
                 scene.name = name;
                 let mut baseline = self.edit.snapshot();
-                if saved.left_out_materials.is_empty() {
+                // What the file holds is saved; edits it could not hold
+                // stay marked (the camera is compared as edited: an NFF
+                // angle may round the field of view in its last bit).
+                let reloaded = &self.edit.loaded;
+                if reloaded.lights.len() == baseline.lights.len() {
+                    baseline.lights.clone_from(&reloaded.lights);
+                }
+                if reloaded.materials.len() == baseline.materials.len() {
+                    baseline.materials.clone_from(&reloaded.materials);
+                }
+                if saved.left_out.is_empty() {
                     self.say(format!("saved {}", shown.display()), false);
                 } else {
-                    // Those materials stay marked as unsaved.
-                    baseline.materials.clone_from(&self.edit.loaded.materials);
                     self.say(
                         format!(
-                            "saved {}, without the edits to {}: a TOML scene takes a mesh's materials from its .mtl file (export a PNG to keep them)",
+                            "saved {}, without {}: the file's format has no place for them (export a PNG to keep them)",
                             shown.display(),
-                            saved.left_out_materials.join(", ")
+                            saved.left_out.join(", ")
                         ),
                         true,
                     );

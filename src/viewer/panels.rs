@@ -317,6 +317,9 @@ fn lights_ui(edit: &mut EditState, speed: f64, ui: &mut egui::Ui) {
 /// Every material's colour and coefficients, within the ranges scene files
 /// are held to.
 fn materials_ui(edit: &mut EditState, ui: &mut egui::Ui) {
+    // NFF weights the ambient term by Kd: an edit keeps them together, as
+    // the saved file will.
+    let ka_follows_kd = super::save::is_nff(&edit.source);
     for i in 0..edit.scene.materials.len() {
         let mut m = edit.scene.materials[i].clone();
         let mut changed = false;
@@ -351,6 +354,9 @@ fn materials_ui(edit: &mut EditState, ui: &mut egui::Ui) {
                     });
             });
         if changed {
+            if ka_follows_kd {
+                m.ka = m.kd;
+            }
             edit.scene_mut().materials[i] = m;
         }
     }

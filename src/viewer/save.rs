@@ -1,21 +1,32 @@
-//! "Save scene": the viewer's edits written into a TOML scene file (see
-//! [`crate::scene::save`]), atomically, then read back to prove it loads.
+//! "Save scene": the viewer's edits written into the scene's file, TOML or
+//! NFF (see [`crate::scene::save`]), atomically, then read back to prove it
+//! loads.
 
 use std::path::{Path, PathBuf};
 
 use super::export::file_dialog_available;
 use super::state::{EditState, SceneSource};
 use crate::scene::Scene;
-use crate::scene::save::{MeshPaths, SaveRequest, scene_toml};
+use crate::scene::save::{MeshPaths, SaveRequest, scene_nff, scene_toml};
 
-/// Whether "Save scene" can write into the scene's own file: only a TOML
-/// scene file can be edited in place (the built-in scene, an OBJ opened on
-/// its own and an NFF scene need a new file).
+/// Whether "Save scene" can write into the scene's own file: a TOML or an
+/// NFF scene file can be edited in place (the built-in scene and an OBJ
+/// opened on its own need a new file).
 pub fn saves_in_place(source: &SceneSource) -> bool {
+    is_nff(source)
+        || source
+            .path()
+            .and_then(Path::extension)
+            .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
+}
+
+/// Whether the scene is an NFF file, which is saved as NFF (TOML has no
+/// cones or polygon patches).
+pub(super) fn is_nff(source: &SceneSource) -> bool {
     source
         .path()
         .and_then(Path::extension)
-        .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
+        .is_some_and(|e| e.eq_ignore_ascii_case("nff"))
 }
 
 /// Where "Save scene as" writes: chosen in a save dialog, or, without one,
@@ -28,22 +39,27 @@ pub fn choose_path(source: &SceneSource) -> Option<PathBuf> {
         None => std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
     };
     let stem = source.stem();
+    let (extension, filter) = if is_nff(source) {
+        ("nff", "NFF scene")
+    } else {
+        ("toml", "glint scene")
+    };
     if file_dialog_available() {
         let name = if saves_in_place(source) {
-            format!("{stem}-edited.toml")
+            format!("{stem}-edited.{extension}")
         } else {
-            format!("{stem}.toml")
+            format!("{stem}.{extension}")
         };
         return rfd::FileDialog::new()
             .set_directory(&folder)
             .set_file_name(&name)
-            .add_filter("glint scene", &["toml"])
+            .add_filter(filter, &[extension])
             .save_file();
     }
     (1..)
         .map(|k| match k {
-            1 => folder.join(format!("{stem}-edited.toml")),
-            k => folder.join(format!("{stem}-edited-{k}.toml")),
+            1 => folder.join(format!("{stem}-edited.{extension}")),
+            k => folder.join(format!("{stem}-edited-{k}.{extension}")),
         })
         .find(|p| !p.exists())
 }
@@ -52,18 +68,22 @@ pub fn choose_path(source: &SceneSource) -> Option<PathBuf> {
 pub struct Saved {
     /// The saved file, loaded back: the new "as loaded" scene.
     pub scene: Scene,
-    /// Edited materials the file could not hold (a mesh's MTL materials).
-    pub left_out_materials: Vec<String>,
+    /// Edits the file's format could not hold, in a few words each.
+    pub left_out: Vec<String>,
 }
 
-/// Writes `edit` to `destination` as TOML and loads the file back.
+/// Writes `edit` to `destination` (TOML, or NFF for an NFF scene) and
+/// loads the file back.
 pub fn save(edit: &EditState, destination: &Path) -> anyhow::Result<Saved> {
-    let is_toml = destination
+    let extension = if is_nff(&edit.source) { "nff" } else { "toml" };
+    let named_right = destination
         .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+        .is_some_and(|e| e.eq_ignore_ascii_case(extension));
     anyhow::ensure!(
-        is_toml,
-        "name the scene file .toml (glint saves TOML scenes)"
+        named_right,
+        "name the scene file .{extension} (glint saves {} scenes as {})",
+        if extension == "nff" { "NFF" } else { "its" },
+        extension.to_uppercase()
     );
     let builtin = edit.source == SceneSource::BuiltIn;
     let loaded_path = match edit.source.path() {
@@ -83,7 +103,11 @@ pub fn save(edit: &EditState, destination: &Path) -> anyhow::Result<Saved> {
             MeshPaths::Anchored
         },
     };
-    let saved = scene_toml(&request, destination)?;
+    let saved = if extension == "nff" {
+        scene_nff(&request)?
+    } else {
+        scene_toml(&request, destination)?
+    };
     if builtin {
         write_builtin_mesh(destination)?;
     }
@@ -91,7 +115,7 @@ pub fn save(edit: &EditState, destination: &Path) -> anyhow::Result<Saved> {
     let scene = crate::scene::load(destination)?;
     Ok(Saved {
         scene,
-        left_out_materials: saved.left_out_materials,
+        left_out: saved.left_out,
     })
 }
 
