@@ -246,6 +246,80 @@ fn a_new_job_cancels_the_old_one_within_a_tile() {
     );
 }
 
+/// Switching back to an image already rendered (the view, anti-aliasing)
+/// shows it from the worker's cache: no tile is rendered, and the bytes
+/// are those a fresh render gives. The octree switch (whose time is the
+/// point of toggling it) and an edit (a new scene) render again.
+#[test]
+fn view_switches_show_passes_already_rendered_without_rendering() {
+    use glint::settings::ViewMode;
+    let worker = Worker::spawn(2, || {});
+    let (full, scene, octree) = job("scenes/glass.toml", 48, 36, AntiAliasing::Full);
+    let first = worker.submit(full.clone());
+    assert!(worker.wait_finished(first, WAIT));
+    let fresh = |j: &Job| {
+        let other = Worker::spawn(2, || {});
+        let g = other.submit(j.clone());
+        assert!(other.wait_finished(g, WAIT));
+        other.with_buffer(|b| b.rgba.clone())
+    };
+    let mut aa_need = full.clone();
+    aa_need.settings.view = ViewMode::AaNeed;
+    let mut off = full.clone();
+    off.settings.set_anti_aliasing(AntiAliasing::Off);
+    for (name, j) in [("aa-need", &aa_need), ("AA off", &off), ("shaded", &full)] {
+        let g = worker.submit(j.clone());
+        assert!(worker.wait_finished(g, WAIT), "{name}");
+        assert_eq!(worker.tiles_started(g), 0, "{name} was rendered again");
+        assert_eq!(worker.with_buffer(|b| b.rgba.clone()), fresh(j), "{name}");
+        let records: Vec<_> = worker
+            .history()
+            .into_iter()
+            .filter(|r| r.generation == g)
+            .collect();
+        assert!(
+            !records.is_empty() && records.iter().all(|r| r.from_cache),
+            "{name}"
+        );
+    }
+    let mut brute_force = off.clone();
+    brute_force.settings.use_octree = false;
+    let g = worker.submit(brute_force);
+    assert!(worker.wait_finished(g, WAIT));
+    assert!(
+        worker.tiles_started(g) > 0,
+        "octree off: rendered and timed"
+    );
+    // The cost view counts the octree's tests: another octree, another image.
+    let mut cost = full.clone();
+    cost.settings.view = ViewMode::Cost;
+    let g = worker.submit(cost.clone());
+    assert!(worker.wait_finished(g, WAIT));
+    assert!(worker.tiles_started(g) > 0);
+    let finer = glint::accel::OctreeParams {
+        leaf_size: 1,
+        ..scene.octree_params
+    };
+    cost.octree = Arc::new(Octree::build(&scene.shapes, finer).unwrap());
+    let g = worker.submit(cost);
+    assert!(worker.wait_finished(g, WAIT));
+    assert!(
+        worker.tiles_started(g) > 0,
+        "cost view, another octree: rendered"
+    );
+    // An edited scene is a new scene.
+    let mut edited = (*scene).clone();
+    edited.lights[0].color *= 0.5;
+    let edited_job = Job {
+        scene: Arc::new(edited),
+        octree,
+        ..full
+    };
+    let g = worker.submit(edited_job);
+    assert!(worker.wait_finished(g, WAIT));
+    assert!(worker.tiles_started(g) > 0, "an edit renders again");
+}
+
 /// Runs frames until the current generation's final pass is on screen.
 fn settle(h: &mut Harness<'static, GlintApp>) {
     let generation = h.state().worker().generation();

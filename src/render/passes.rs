@@ -141,7 +141,11 @@ pub struct PassSummary {
 /// last pass, the difference image) and its summary.
 pub struct FinishedPass<'a> {
     pub info: PassInfo,
+    /// The frame to show.
     pub frame: &'a Frame,
+    /// What the pass traced: `frame` itself, except for the aa-need view's
+    /// last pass, whose `frame` is the difference of two traced frames.
+    pub traced: &'a Frame,
     pub summary: &'a PassSummary,
 }
 
@@ -311,17 +315,19 @@ impl Renderer<'_> {
                     }),
             };
             total += counts;
-            let shown = match &first {
+            let difference = match &first {
                 Some(one) if info.is_last() && view == ViewMode::AaNeed => {
-                    Frame::aa_need(&one.frame, &frame)
+                    Some(Frame::aa_need(&one.frame, &frame))
                 }
-                _ => frame,
+                _ => None,
             };
             watch.pass_done(&FinishedPass {
                 info,
-                frame: &shown,
+                frame: difference.as_ref().unwrap_or(&frame),
+                traced: &frame,
                 summary: &summary,
             });
+            let shown = difference.unwrap_or(frame);
             summaries.push(summary);
             if info.is_last() {
                 return Some(RenderedFrame {

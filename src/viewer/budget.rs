@@ -130,6 +130,7 @@ mod tests {
             view: crate::settings::ViewMode::Shaded,
             max_depth: 5,
             protocol: crate::settings::Protocol::Glint,
+            from_cache: false,
         }
     }
 

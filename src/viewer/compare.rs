@@ -333,6 +333,7 @@ mod tests {
             view: ViewMode::Shaded,
             max_depth: 5,
             protocol: crate::settings::Protocol::Glint,
+            from_cache: false,
         };
         let preview = PassKind::Preview(super::super::worker::Preview {
             divisor: 2,

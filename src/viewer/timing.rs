@@ -71,6 +71,16 @@ fn legend_ui(worker: &Worker, ui: &mut egui::Ui) {
     });
 }
 
+/// A pass's time; one shown again from the worker's cache says so (its
+/// time is what it took when it was rendered).
+fn pass_time(r: &PassRecord) -> String {
+    if r.from_cache {
+        format!("{:.3} s (kept: not rendered again)", r.seconds)
+    } else {
+        format!("{:.3} s", r.seconds)
+    }
+}
+
 fn timing_grid_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
     let history = info.worker.history();
     ui.heading("Timing");
@@ -109,19 +119,13 @@ fn timing_grid_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
                 "–"
             };
             if let Some(r) = of_shown(PassKind::Corners) {
-                row("SPD corner pass", format!("{:.3} s", r.seconds));
+                row("SPD corner pass", pass_time(r));
             } else {
                 let one = of_shown(PassKind::OneSample);
                 let sixteen = of_shown(PassKind::SixteenSamples);
-                row(
-                    "1-sample pass",
-                    one.map_or(pending.into(), |r| format!("{:.3} s", r.seconds)),
-                );
+                row("1-sample pass", one.map_or(pending.into(), pass_time));
                 if edit.settings.samples > 1 || sixteen.is_some() {
-                    row(
-                        "16-sample pass",
-                        sixteen.map_or(pending.into(), |r| format!("{:.3} s", r.seconds)),
-                    );
+                    row("16-sample pass", sixteen.map_or(pending.into(), pass_time));
                 }
                 if let Some(r) = sixteen
                     && let Some(refined) = r.refined_pixels
@@ -289,9 +293,10 @@ fn pass_plot_ui(history: &[PassRecord], ui: &mut egui::Ui) {
         Color32::from_rgb(240, 110, 160),
         Color32::from_rgb(170, 170, 170),
     ];
+    // Passes shown again from the cache took no time now.
     let full: Vec<_> = history
         .iter()
-        .filter(|r| !matches!(r.kind, PassKind::Preview(_)))
+        .filter(|r| !matches!(r.kind, PassKind::Preview(_)) && !r.from_cache)
         .collect();
     // Series in order of first appearance, each keeping its colour.
     let mut keys: Vec<SeriesKey> = Vec::new();

@@ -132,6 +132,9 @@ pub struct PassRecord {
     pub view: crate::settings::ViewMode,
     pub max_depth: u32,
     pub protocol: crate::settings::Protocol,
+    /// Shown from the pass cache, not rendered again: `seconds` is the
+    /// time the pass took when it was rendered.
+    pub from_cache: bool,
 }
 
 /// The display buffer: RGBA8, exactly what the viewer shows and exports.
@@ -191,6 +194,100 @@ struct Shared {
     last_repaint: Mutex<Instant>,
     /// What went wrong in the worker, for the status bar (taken by the UI).
     failure: Mutex<Option<String>>,
+    /// Recent finished passes, shown again without rendering.
+    cache: Mutex<PassCache>,
+}
+
+/// What decides a pass: the scene (by identity: an edit makes a new one),
+/// the camera, the settings as the pass traces them (its own sampling, the
+/// shaded view for aa-need) and, for the cost views, the octree itself
+/// (its tests are what they show). The octree switch is part of the
+/// settings although the pixels do not depend on it: its time is what a
+/// user toggles it to see.
+#[derive(Clone)]
+struct PassKey {
+    scene: Arc<Scene>,
+    octree: Option<Arc<Octree>>,
+    camera: CameraSpec,
+    settings: RenderSettings,
+    pass: crate::render::PassKind,
+}
+
+impl PassKey {
+    fn of(job: &Job, pass: crate::render::PassKind) -> Self {
+        use crate::render::PassKind as Engine;
+        use crate::settings::ViewMode;
+        let mut settings = job.settings;
+        if settings.view == ViewMode::AaNeed {
+            settings.view = ViewMode::Shaded;
+        }
+        match pass {
+            Engine::OneSample => (settings.samples, settings.adaptive) = (1, false),
+            Engine::Grid => (settings.samples, settings.adaptive) = (16, false),
+            Engine::Refine => (settings.samples, settings.adaptive) = (16, true),
+            Engine::Corners => {}
+        }
+        let counts_tests = matches!(settings.view, ViewMode::Cost | ViewMode::CostSteps);
+        PassKey {
+            scene: Arc::clone(&job.scene),
+            octree: counts_tests.then(|| Arc::clone(&job.octree)),
+            camera: job.camera,
+            settings,
+            pass,
+        }
+    }
+
+    fn matches(&self, other: &PassKey) -> bool {
+        Arc::ptr_eq(&self.scene, &other.scene)
+            && match (&self.octree, &other.octree) {
+                (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+                (None, None) => true,
+                _ => false,
+            }
+            && self.camera == other.camera
+            && self.settings == other.settings
+            && self.pass == other.pass
+    }
+}
+
+struct CachedPass {
+    key: PassKey,
+    frame: Frame,
+    record: PassRecord,
+}
+
+/// The last few finished passes, newest last, within a memory bound: a
+/// view or anti-aliasing switch back to an image already rendered shows
+/// it at once.
+#[derive(Default)]
+struct PassCache {
+    entries: Vec<CachedPass>,
+}
+
+impl PassCache {
+    /// At most this many frames of f64 pixels are kept (a 4x4-inch image
+    /// at 800x600 is 11 MiB).
+    const MAX_BYTES: usize = 256 << 20;
+
+    fn bytes(frame: &Frame) -> usize {
+        frame.pixels.len() * std::mem::size_of_val(&crate::math::DVec3::ZERO)
+    }
+
+    fn insert(&mut self, pass: CachedPass) {
+        if Self::bytes(&pass.frame) > Self::MAX_BYTES / 2 {
+            return;
+        }
+        self.entries.retain(|e| !e.key.matches(&pass.key));
+        self.entries.push(pass);
+        let mut total: usize = self.entries.iter().map(|e| Self::bytes(&e.frame)).sum();
+        while total > Self::MAX_BYTES {
+            total -= Self::bytes(&self.entries.remove(0).frame);
+        }
+    }
+
+    fn find(&self, key: &PassKey) -> Option<&CachedPass> {
+        self.entries.iter().rev().find(|e| e.key.matches(key))
+    }
 }
 
 /// Tiles arrive far faster than a screen refreshes; asking for a repaint
@@ -239,6 +336,7 @@ impl Worker {
             tiles_started: Mutex::new(Vec::new()),
             last_repaint: Mutex::new(Instant::now()),
             failure: Mutex::new(None),
+            cache: Mutex::new(PassCache::default()),
         });
         let (tx, rx) = channel();
         let thread_shared = Arc::clone(&shared);
@@ -408,6 +506,9 @@ fn render_job(shared: &Shared, generation: u64, job: &Job) {
             return;
         }
     };
+    if job.preview.is_none() && show_cached(shared, generation, job, &renderer.plan(true)) {
+        return;
+    }
     let watch = Display {
         shared,
         generation,
@@ -420,6 +521,84 @@ fn render_job(shared: &Shared, generation: u64, job: &Job) {
         progressive: job.preview.is_none(),
     };
     renderer.render_frame(options, &watch);
+}
+
+/// Shows the job's image from the pass cache when every pass it needs is
+/// there (the last pass; for aa-need the 1-sample pass too), with their
+/// records marked as from the cache. `false`: it must be rendered.
+fn show_cached(
+    shared: &Shared,
+    generation: u64,
+    job: &Job,
+    plan: &[crate::render::PassKind],
+) -> bool {
+    use crate::render::PassKind as Engine;
+    use crate::settings::ViewMode;
+    let Some(&last) = plan.last() else {
+        return false;
+    };
+    let aa_need = job.settings.view == ViewMode::AaNeed;
+    let (frame, records, one_sample) = {
+        let cache = shared.cache.lock().unwrap_or_else(|e| e.into_inner());
+        let Some(final_pass) = cache.find(&PassKey::of(job, last)) else {
+            return false;
+        };
+        let mut records = vec![final_pass.record];
+        let frame = if aa_need && last != Engine::OneSample {
+            let Some(one) = cache.find(&PassKey::of(job, Engine::OneSample)) else {
+                return false;
+            };
+            records.insert(0, one.record);
+            Frame::aa_need(&one.frame, &final_pass.frame)
+        } else {
+            final_pass.frame.clone()
+        };
+        (frame, records, last == Engine::OneSample)
+    };
+    if shared.generation.load(Ordering::SeqCst) != generation {
+        return true;
+    }
+    if let Ok(mut history) = shared.history.lock() {
+        let now = shared.started.elapsed().as_secs_f64();
+        for r in records {
+            history.push(PassRecord {
+                generation,
+                anti_aliasing: job.settings.samples > 1,
+                octree: job.settings.use_octree,
+                view: job.settings.view,
+                finished_at: now,
+                from_cache: true,
+                ..r
+            });
+        }
+    }
+    let mut settings = job.settings;
+    if one_sample {
+        settings.set_anti_aliasing(crate::settings::AntiAliasing::Off);
+    }
+    settings.view = frame.view;
+    {
+        let mut b = shared.buffer.lock().unwrap_or_else(|e| e.into_inner());
+        b.generation = generation;
+        b.rgba = rgb_to_rgba(&frame.to_rgb8());
+        b.width = frame.width;
+        b.height = frame.height;
+        b.pass = Some(PassKind::of(last, None));
+        b.tiles_done = 0;
+        b.tiles_total = 0;
+        b.finished = true;
+        b.pass_started = None;
+        b.stopped = false;
+        b.source = Some(FrameSource {
+            scene: Arc::clone(&job.scene),
+            camera: job.camera,
+            settings,
+        });
+        b.last_frame = Some(frame);
+        b.version += 1;
+    }
+    (shared.repaint)();
+    true
 }
 
 /// Shows a job's passes: tiles sweep into the display buffer as they
@@ -535,7 +714,20 @@ impl PassWatch for Display<'_> {
                 view: self.job.settings.view,
                 max_depth: self.settings.max_depth,
                 protocol: self.settings.protocol,
+                from_cache: false,
             });
+            if self.job.preview.is_none() {
+                let record = history[history.len() - 1];
+                self.shared
+                    .cache
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .insert(CachedPass {
+                        key: PassKey::of(self.job, pass.info.kind),
+                        frame: pass.traced.clone(),
+                        record,
+                    });
+            }
         }
         let frame = pass.frame;
         let rgba = rgb_to_rgba(&frame.to_rgb8());
