@@ -1,0 +1,399 @@
+#!/usr/bin/env python3
+"""Measures every figure the README quotes and writes it into the README.
+
+    cargo build --release
+    python3 benches/readme_figures.py              # every section (about 40 minutes on 2 cores)
+    python3 benches/readme_figures.py spd-table    # one or more sections
+    python3 benches/readme_figures.py --list       # the sections and their commands
+
+Each section runs glint's own commands (target/release/glint, never built
+here) and replaces the README's text between `<!-- figures:NAME -->` and
+`<!-- /figures:NAME -->`, so no quoted figure is typed by hand. Figures
+outside those blocks are history (what a change measured when it was
+made) and say so. Needs Python 3 (standard library only); the `kernels`
+section needs valgrind, `peers` what benches/peers/run.sh installs.
+"""
+
+import json
+import os
+import platform
+import re
+import statistics
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+import zlib
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+GLINT = os.path.join(ROOT, "target", "release", "glint")
+README = os.path.join(ROOT, "README.md")
+SPD = ["balls", "gears", "mount", "rings", "teapot", "tetra", "tree"]
+SPD_FILES = [f"scenes/spd/{s}.nff" for s in SPD]
+
+
+def run(args, **kw):
+    """Runs a command from the repository root; its stdout as text."""
+    shown = " ".join(args)
+    print(f"  $ {shown}", file=sys.stderr, flush=True)
+    done = subprocess.run(args, cwd=ROOT, stdout=subprocess.PIPE, text=True, check=False, **kw)
+    if done.returncode != 0:
+        sys.exit(f"readme_figures: `{shown}` failed with status {done.returncode}")
+    return done.stdout
+
+
+def glint(*args):
+    return run([GLINT, *args])
+
+
+def bench_json(*args):
+    return json.loads(glint("bench", *args, "--format", "json"))
+
+
+def cores():
+    return os.cpu_count() or 1
+
+
+def cpu_model():
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown CPU"
+
+
+def stamp(section):
+    day = time.strftime("%Y-%m-%d", time.gmtime())
+    return (
+        f"*Measured {day} on {cores()} cores ({cpu_model()}) by "
+        f"`python3 benches/readme_figures.py {section}`.*"
+    )
+
+
+def table_rows(markdown):
+    """The cells of a markdown table's body rows."""
+    rows = []
+    for line in markdown.splitlines():
+        if line.startswith("|") and not line.startswith("|---"):
+            rows.append([c.strip() for c in line.strip().strip("|").split("|")])
+    return rows[1:]
+
+
+def seconds(cell):
+    """`25.95 (est., rows 1/6)` -> 25.95."""
+    return float(cell.split()[0])
+
+
+def fmt(x, digits=2):
+    return f"{x:,.{digits}f}"
+
+
+# --- sections -----------------------------------------------------------
+
+
+def spd_table():
+    out = glint(
+        "bench", *SPD_FILES, "--size", "512x512", "--samples", "1", "--repeat", "3",
+        "--brute-force-budget", "2e9",
+    )
+    table = "\n".join(l for l in out.splitlines() if l.startswith("|"))
+    rows = table_rows(table)
+    on = {r[0]: seconds(r[5]) for r in rows}
+    speedups = [float(r[7].rstrip("x")) for r in rows]
+    tests = {r[0]: (float(r[9]), float(r[12])) for r in rows}
+    slowest = max(on, key=on.get)
+    build = {r[0]: float(r[4]) for r in rows}[slowest]
+    worst = max(tests, key=lambda s: tests[s][0] / tests[s][1])
+    ratio = tests[worst][0] / tests[worst][1]
+    return (
+        f"{table}\n\n"
+        f"With the octree every SPD scene renders in {min(on.values()):.2f} to "
+        f"{max(on.values()):.2f} s ({slowest.removesuffix('.nff')} the slowest; its "
+        f"{build:.2f} s build is timed apart), {min(speedups):.0f}x to "
+        f"{max(speedups):.0f}x faster than brute force, with at most {ratio:.2f}x the "
+        f"intersection tests per ray of the best of Havran's octrees "
+        f"({worst.removesuffix('.nff')}: {tests[worst][0]:.2f} against "
+        f"{tests[worst][1]:.2f}).\n\n{stamp('spd-table')}"
+    )
+
+
+def spd_protocol():
+    rows = bench_json(*SPD_FILES, "--protocol", "spd", "--octree-only", "--repeat", "3")
+    times = ", ".join(
+        f"{os.path.basename(r['scene']).removesuffix('.nff')} {r['octree_on']['render_s']:.2f} s"
+        for r in rows
+    )
+    return f"Under `--protocol spd`: {times}.\n\n{stamp('spd-protocol')}"
+
+
+def scaling():
+    files = (
+        [f"scenes/spd/sizes/balls_s{k}.nff" for k in (1, 2, 3)]
+        + ["scenes/spd/balls.nff", "scenes/spd/sizes/balls_s5.nff", "scenes/spd/sizes/tetra_s4.nff",
+           "scenes/spd/tetra.nff", "scenes/spd/sizes/tetra_s8.nff"]
+    )
+    rows = bench_json(*files, "--size", "512x512", "--samples", "1", "--repeat", "1",
+                      "--brute-force-budget", "5e8")
+    lines = [
+        "| scene | shapes | build (s) | memory (KiB) | octree on (s) | octree off (s) | speedup | N_IT | N_TS |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    for r in rows:
+        off = r["octree_off"]
+        off_s = f"{off['render_s']:.2f}"
+        if off.get("estimated"):
+            off_s += f" (est., rows 1/{r['compared_rows_every']})"
+        name = os.path.basename(r["scene"]).removesuffix(".nff")
+        lines.append(
+            f"| {name} | {r['shapes']} | {r['build_s']:.3f} | "
+            f"{r['octree_stats']['memory_bytes'] // 1024} | {r['octree_on']['render_s']:.3f} | "
+            f"{off_s} | {r['speedup']:.0f}x | {r['octree_on']['intersection_tests_per_ray']:.2f} | "
+            f"{r['octree_on']['traversal_steps_per_ray']:.2f} |"
+        )
+    return "\n".join(lines) + f"\n\n{stamp('scaling')}"
+
+
+def peers():
+    out = run(["bash", "benches/peers/run.sh", "2"])
+    table = "\n".join(l for l in out.splitlines() if l.startswith("|"))
+    return f"{table}\n\n{stamp('peers')}"
+
+
+def instructions(args, width, height):
+    """Instructions per ray: cachegrind at the working size minus the same
+    at 1x1 (loading and the octree build), over the render's rays."""
+    def count(w, h):
+        with tempfile.TemporaryDirectory() as d:
+            out = os.path.join(d, "cg.out")
+            run(["valgrind", "--tool=cachegrind", "--cache-sim=no", f"--cachegrind-out-file={out}",
+                 GLINT, "render", *args, "-o", os.path.join(d, "x.png"), "--width", str(w),
+                 "--height", str(h), "--threads", "1", "-q"],
+                env={**os.environ, "GLINT_SIMD": "avx2"}, stderr=subprocess.DEVNULL)
+            with open(out) as f:
+                for line in f:
+                    if line.startswith("summary:"):
+                        return int(line.split()[1])
+        sys.exit("readme_figures: no cachegrind summary")
+    with tempfile.TemporaryDirectory() as d:
+        stats = json.loads(glint("render", *args, "-o", os.path.join(d, "x.png"), "--width",
+                                 str(width), "--height", str(height), "--threads", "1",
+                                 "--stats", "-q"))
+    return (count(width, height) - count(1, 1)) / stats["rays"]["total"]
+
+
+# Instructions per ray before each step of issue 20, measured when each
+# step was made (history: the code they measured is gone).
+KERNEL_HISTORY = {
+    "bunny primary rays, normals view, 256x192": (2655, 1953, 1066),
+    "bunny on floor, 16 spp, 128x96": (3552, 3203, 1326),
+    "`scenes/default.toml`, 1 spp, 200x150": (2056, 1812, 1573),
+}
+
+
+def kernels():
+    workloads = [
+        ("bunny primary rays, normals view, 256x192",
+         ["scenes/bunny.toml", "--view", "normals", "--samples", "1"], 256, 192),
+        ("bunny on floor, 16 spp, 128x96", ["benches/peers/bunny_floor.toml"], 128, 96),
+        ("`scenes/default.toml`, 1 spp, 200x150", ["scenes/default.toml", "--samples", "1"], 200, 150),
+    ]
+    lines = [
+        "| workload | before (issue 20) | lean single-ray walk | packets | now |",
+        "|---|---:|---:|---:|---:|",
+    ]
+    for name, args, w, h in workloads:
+        now = instructions(args, w, h)
+        before = KERNEL_HISTORY[name]
+        lines.append(f"| {name} | {before[0]:,} | {before[1]:,} | {before[2]:,} | {now:,.0f} |")
+    return "\n".join(lines) + f"\n\n{stamp('kernels')}"
+
+
+def png_rgb(path):
+    """The RGB bytes of an 8-bit RGB or RGBA, non-interlaced PNG (what glint
+    writes)."""
+    with open(path, "rb") as f:
+        data = f.read()
+    pos, idat, width = 8, b"", 0
+    while pos < len(data):
+        length, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        body = data[pos + 8:pos + 8 + length]
+        if kind == b"IHDR":
+            width, height, depth, color = struct.unpack(">IIBB", body[:10])
+            if depth != 8 or color not in (2, 6) or body[12] != 0:
+                sys.exit(f"readme_figures: {path} is not 8-bit RGB(A), non-interlaced")
+            channels = 3 if color == 2 else 4
+        elif kind == b"IDAT":
+            idat += body
+        pos += 12 + length
+    raw = zlib.decompress(idat)
+    stride = width * channels
+    out, prev, i = bytearray(), bytearray(stride), 0
+    for _ in range(height):
+        kind, line = raw[i], bytearray(raw[i + 1:i + 1 + stride])
+        i += 1 + stride
+        for x in range(stride):
+            a = line[x - channels] if x >= channels else 0
+            b = prev[x]
+            c = prev[x - channels] if x >= channels else 0
+            if kind == 1:
+                line[x] = (line[x] + a) & 255
+            elif kind == 2:
+                line[x] = (line[x] + b) & 255
+            elif kind == 3:
+                line[x] = (line[x] + (a + b) // 2) & 255
+            elif kind == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                pred = a if pa <= pb and pa <= pc else (b if pb <= pc else c)
+                line[x] = (line[x] + pred) & 255
+        prev = line
+        for x in range(0, stride, channels):
+            out += line[x:x + 3]
+    return bytes(out)
+
+
+def psnr(a, b):
+    mse = sum((x - y) ** 2 for x, y in zip(a, b)) / len(a)
+    return float("inf") if mse == 0 else 10 * __import__("math").log10(255 ** 2 / mse)
+
+
+def adaptive():
+    scene = "scenes/default.toml"
+    times = {
+        aa: bench_json(scene, "--aa", aa, "--octree-only", "--repeat", "5")[0]["octree_on"]["render_s"]
+        for aa in ("off", "adaptive", "full")
+    }
+    with tempfile.TemporaryDirectory() as d:
+        images, refined = {}, None
+        for aa in ("off", "adaptive", "full"):
+            png = os.path.join(d, f"{aa}.png")
+            stats = json.loads(glint("render", scene, "--aa", aa, "-o", png, "--stats", "-q"))
+            if aa == "adaptive":
+                refined = stats["refined_fraction"]
+            images[aa] = png_rgb(png)
+    return (
+        f"On `{scene}` at its 800x600 (`glint bench {scene} --aa off|adaptive|full "
+        f"--octree-only --repeat 5`): {times['off']:.3f} s, {times['adaptive']:.3f} s and "
+        f"{times['full']:.3f} s: adaptive costs {100 * times['adaptive'] / times['full']:.0f}% of "
+        f"the full grid, refines {100 * refined:.1f}% of the pixels and is "
+        f"{psnr(images['adaptive'], images['full']):.1f} dB from it (1 sample alone: "
+        f"{psnr(images['off'], images['full']):.1f} dB; PSNR of the 8-bit PNGs).\n\n{stamp('adaptive')}"
+    )
+
+
+def cost_view():
+    scene = "scenes/spd/teapot.nff"
+    with tempfile.TemporaryDirectory() as d:
+        cost = {}
+        for octree in ("off", "on"):
+            stats = json.loads(glint("render", scene, "--width", "512", "--height", "512",
+                                     "--view", "cost", "--octree", octree, "-o",
+                                     os.path.join(d, "c.png"), "--stats", "-q"))
+            cost[octree] = stats["cost_per_pixel"]
+
+        def whole_command(*view):
+            runs = []
+            for _ in range(5):
+                start = time.perf_counter()
+                glint("render", "scenes/spd/balls.nff", "--width", "512", "--height", "512",
+                      *view, "-o", os.path.join(d, "b.png"), "-q")
+                runs.append(time.perf_counter() - start)
+            return statistics.median(runs)
+        shaded = whole_command()
+        with_cost = whole_command("--view", "cost")
+    span = lambda c: f"{c['min']:,.0f} to {c['max']:,.0f} tests per pixel, mean {c['mean']:,.1f}"
+    return (
+        f"On the teapot at 512x512: {span(cost['off'])} without the octree, against "
+        f"{span(cost['on'])} with it (`glint render {scene} --width 512 --height 512 --view cost "
+        f"--octree off -o off.png --stats`, and `--octree on`: `cost_per_pixel`). With the view "
+        f"on, `glint render scenes/spd/balls.nff --width 512 --height 512 --view cost` takes "
+        f"{with_cost:.3f} s against {shaded:.3f} s shaded (median of 5, whole command).\n\n"
+        f"{stamp('cost-view')}"
+    )
+
+
+def study():
+    glint("study", "scenes/default.toml", "scenes/spd/balls.nff", "scenes/spd/tetra.nff",
+          "scenes/spd/teapot.nff", "--out", "benches/study", "--size", "320x240", "--repeat", "3")
+    with open(os.path.join(ROOT, "benches", "study", "study.md")) as f:
+        text = f.read()
+    summary = text.split("## Summary", 1)[1]
+    table = []
+    for line in summary.strip().splitlines():
+        if not line.startswith("|"):
+            break
+        table.append(line)
+    return "\n".join(table) + f"\n\n{stamp('study')}"
+
+
+def prediction():
+    sweep = glint("bench", *SPD_FILES, "--size", "512x512", "--samples", "1", "--repeat", "3",
+                  "--sweep", "--sweep-depths", "6,8,10", "--sweep-leaf-sizes", "2,4,8",
+                  "--format", "json")
+    with open(os.path.join(ROOT, "benches", "prediction-sweep.json"), "w") as f:
+        f.write(sweep)
+    out = run([sys.executable, "benches/prediction.py"], input=sweep)
+    with open(os.path.join(ROOT, "benches", "prediction.md"), "w") as f:
+        f.write(out)
+    # The README quotes the summary tables; every row is in benches/prediction.md.
+    tables = out.split("\n\n", 1)[1].strip()
+    return f"{tables}\n\n{stamp('prediction')}"
+
+
+SECTIONS = {
+    "spd-table": spd_table,
+    "spd-protocol": spd_protocol,
+    "scaling": scaling,
+    "peers": peers,
+    "kernels": kernels,
+    "adaptive": adaptive,
+    "cost-view": cost_view,
+    "study": study,
+    "prediction": prediction,
+}
+
+
+def replace_block(text, name, body):
+    pattern = re.compile(
+        rf"(<!-- figures:{re.escape(name)} -->\n).*?(\n<!-- /figures:{re.escape(name)} -->)",
+        re.S,
+    )
+    if not pattern.search(text):
+        sys.exit(f"readme_figures: README.md has no block `<!-- figures:{name} -->`")
+    return pattern.sub(lambda m: m.group(1) + body + m.group(2), text, count=1)
+
+
+def main():
+    args = sys.argv[1:]
+    if args == ["--list"]:
+        for name, f in SECTIONS.items():
+            print(f"{name}: {f.__name__}")
+        return
+    unknown = [a for a in args if a not in SECTIONS]
+    if unknown:
+        sys.exit(f"readme_figures: unknown section(s) {', '.join(unknown)}; "
+                 f"the sections: {', '.join(SECTIONS)}")
+    if not os.access(GLINT, os.X_OK):
+        sys.exit(f"readme_figures: {GLINT} not found: run `cargo build --release` first")
+    for name in args or list(SECTIONS):
+        start = time.time()
+        print(f"{name} ...", file=sys.stderr, flush=True)
+        body = SECTIONS[name]()
+        with open(README) as f:
+            text = f.read()
+        text = replace_block(text, name, body)
+        # Written through a temporary file, so an interrupted run leaves the
+        # README whole; each finished section is kept.
+        tmp = README + ".tmp"
+        with open(tmp, "w") as f:
+            f.write(text)
+        os.replace(tmp, README)
+        print(f"{name}: done in {time.time() - start:.0f} s", file=sys.stderr, flush=True)
+
+
+if __name__ == "__main__":
+    main()
