@@ -327,7 +327,7 @@ pub struct OctreeOverrides {
 impl OctreeOverrides {
     pub fn apply(&self, params: &mut OctreeParams) {
         if let Some(d) = self.max_depth {
-            params.max_depth = d.min(crate::limits::MAX_OCTREE_DEPTH);
+            params.max_depth = d;
         }
         if let Some(n) = self.leaf_size {
             params.leaf_size = n;

@@ -400,3 +400,83 @@ fn an_interrupted_write_leaves_no_temporary_file() {
     assert_eq!(temporaries(), Vec::<String>::new());
     assert!(!out.exists(), "no half-written output");
 }
+
+/// One set of limits: every extreme value `glint render` accepts is read
+/// back by `glint info` and `--from-png` (which renders the same pixels),
+/// and one step past it is refused before anything is written.
+#[test]
+fn every_value_the_cli_accepts_is_read_back_and_one_past_it_refused() {
+    let tmp = common::temp_dir();
+    let first = tmp.path().join("first.png");
+    let again = tmp.path().join("again.png");
+    let scene = scene();
+    let render = |extra: &[&str], out: &Path| {
+        let mut args = vec!["render", "-q"];
+        args.extend(extra);
+        if !extra.contains(&"--from-png") {
+            args.push(&scene);
+            if !extra.contains(&"--width") {
+                args.extend(["--width", "8", "--height", "6"]);
+            }
+        }
+        args.extend(["-o", out.to_str().unwrap()]);
+        glint(&args)
+    };
+    let pixels = |p: &Path| image::open(p).unwrap().to_rgb8().into_raw();
+    let max_side = glint::limits::MAX_IMAGE_SIDE.to_string();
+    let max_depth = glint::limits::MAX_RAY_DEPTH.to_string();
+    let max_octree = glint::limits::MAX_OCTREE_DEPTH.to_string();
+    let max_budget = glint::limits::MAX_MEMORY_BUDGET_MIB.to_string();
+    let accepted: Vec<Vec<&str>> = vec![
+        vec!["--width", &max_side, "--height", "1"],
+        vec!["--width", "1", "--height", &max_side],
+        vec!["--max-depth", &max_depth],
+        vec!["--max-depth", "1"],
+        vec!["--samples", "16"],
+        vec!["--aa", "adaptive"],
+        vec!["--octree-max-depth", &max_octree],
+        vec!["--octree-max-depth", "0"],
+        vec!["--octree-leaf-size", "4294967295"],
+        vec!["--octree-leaf-size", "1"],
+        vec!["--octree-max-duplication", "1"],
+        vec!["--octree-max-duplication", "8"],
+        vec!["--octree-memory-budget", "1"],
+        vec!["--octree-memory-budget", &max_budget],
+        vec!["--overlay", "octree", "--overlay-depth", &max_octree],
+        vec!["--view", "cost", "--legend", "off"],
+    ];
+    for extra in &accepted {
+        let _ = std::fs::remove_file(&first);
+        let o = render(extra, &first);
+        assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
+        let info = glint(&["info", first.to_str().unwrap()]);
+        assert!(info.status.success(), "{extra:?}: info: {}", stderr(&info));
+        let o = render(&["--from-png", first.to_str().unwrap()], &again);
+        assert!(o.status.success(), "{extra:?}: --from-png: {}", stderr(&o));
+        assert!(pixels(&first) == pixels(&again), "{extra:?}: other pixels");
+    }
+    let past_side = (glint::limits::MAX_IMAGE_SIDE + 1).to_string();
+    let past_depth = (glint::limits::MAX_RAY_DEPTH + 1).to_string();
+    let past_octree = (glint::limits::MAX_OCTREE_DEPTH + 1).to_string();
+    let past_budget = (glint::limits::MAX_MEMORY_BUDGET_MIB + 1).to_string();
+    let refused: Vec<Vec<&str>> = vec![
+        vec!["--width", &past_side, "--height", "1"],
+        vec!["--max-depth", &past_depth],
+        vec!["--max-depth", "0"],
+        vec!["--octree-max-depth", &past_octree],
+        vec!["--octree-leaf-size", "0"],
+        vec!["--octree-max-duplication", "0"],
+        vec!["--octree-max-duplication", "9"],
+        vec!["--octree-memory-budget", "0"],
+        vec!["--octree-memory-budget", &past_budget],
+        vec!["--overlay", "octree", "--overlay-depth", &past_octree],
+        vec!["--samples", "4"],
+    ];
+    for extra in &refused {
+        let _ = std::fs::remove_file(&first);
+        let o = render(extra, &first);
+        assert!(!o.status.success(), "{extra:?} accepted");
+        assert!(!stderr(&o).is_empty(), "{extra:?}: refused without a word");
+        assert!(!first.exists(), "{extra:?}: a file was written");
+    }
+}

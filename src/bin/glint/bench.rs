@@ -64,14 +64,14 @@ pub struct BenchArgs {
     /// on/off, octree on, one row each (medians of `--repeat` runs).
     #[arg(long)]
     pub sweep: bool,
-    /// Maximum depths for `--sweep`.
-    #[arg(long, value_delimiter = ',', default_value = "6,8,10,12")]
+    /// Maximum depths for `--sweep` (each 0 to 21).
+    #[arg(long, value_delimiter = ',', default_value = "6,8,10,12", value_parser = crate::common::octree_depth)]
     pub sweep_depths: Vec<u32>,
-    /// Leaf sizes for `--sweep`.
-    #[arg(long, value_delimiter = ',', default_value = "2,4,8,16")]
+    /// Leaf sizes for `--sweep` (each at least 1).
+    #[arg(long, value_delimiter = ',', default_value = "2,4,8,16", value_parser = crate::common::parse_positive)]
     pub sweep_leaf_sizes: Vec<u32>,
-    /// Maximum duplication factors for `--sweep` (default: the scene's).
-    #[arg(long, value_delimiter = ',')]
+    /// Maximum duplication factors for `--sweep` (each 1 to 8; default: the scene's).
+    #[arg(long, value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..=8))]
     pub sweep_max_duplications: Vec<u32>,
     /// Cost-driven settings for `--sweep`.
     #[arg(long, value_delimiter = ',', value_enum, default_value = "on,off")]
@@ -432,10 +432,10 @@ fn sweep(args: &BenchArgs) -> Result<()> {
         }
         for (cost_driven, max_depth, leaf_size, max_duplication) in combinations {
             let params = glint::accel::OctreeParams {
-                max_depth: max_depth.min(glint::limits::MAX_OCTREE_DEPTH),
-                leaf_size: leaf_size.max(1),
+                max_depth,
+                leaf_size,
                 cost_driven,
-                max_duplication: max_duplication.clamp(1, 8),
+                max_duplication,
                 ..scene.octree_params
             };
             let (mut builds, mut renders) = (Vec::new(), Vec::new());

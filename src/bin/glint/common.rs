@@ -165,11 +165,23 @@ pub fn anti_aliasing(samples: Option<u32>, aa: Option<AntiAliasing>) -> Option<A
     }))
 }
 
+/// An octree level, 0 to [`glint::limits::MAX_OCTREE_DEPTH`]: what scene
+/// files and export records accept, so whatever a command writes reads back.
+pub fn octree_depth(text: &str) -> Result<u32, String> {
+    let max = glint::limits::MAX_OCTREE_DEPTH;
+    match text.trim().parse::<u32>() {
+        Ok(d) if d <= max => Ok(d),
+        _ => Err(format!(
+            "expected an octree level from 0 to {max}, got `{text}`"
+        )),
+    }
+}
+
 /// Octree parameters on the command line; unset ones keep the scene's.
 #[derive(clap::Args, Clone, Copy, Debug, Default)]
 pub struct OctreeArgs {
-    /// Deepest octree level (root = 0).
-    #[arg(long)]
+    /// Deepest octree level (root = 0; at most 21).
+    #[arg(long, value_parser = octree_depth)]
     pub octree_max_depth: Option<u32>,
     /// References up to which a node stays a leaf.
     #[arg(long, value_parser = parse_positive)]

@@ -85,8 +85,9 @@ pub struct RenderArgs {
     #[arg(long, value_enum)]
     pub overlay: Option<OverlayKind>,
     /// Deepest octree level the overlay draws (deeper subtrees are drawn
-    /// as one box at this level). Default 4, or the recorded one with --from-png.
-    #[arg(long)]
+    /// as one box at this level; at most 21). Default 4, or the recorded one
+    /// with --from-png.
+    #[arg(long, value_parser = crate::common::octree_depth)]
     pub overlay_depth: Option<u32>,
     /// The legend strip under diagnostic views (cost, cost-steps, aa-need,
     /// depth) and the octree overlay: on (the default, or the recorded

@@ -39,8 +39,8 @@ pub struct ViewArgs {
     /// Window size as WIDTHxHEIGHT in points.
     #[arg(long, default_value = "1400x860", value_parser = parse_size)]
     pub window: (u32, u32),
-    /// Start with the octree overlay drawn down to this level.
-    #[arg(long, value_name = "DEPTH")]
+    /// Start with the octree overlay drawn down to this level (0 to 21).
+    #[arg(long, value_name = "DEPTH", value_parser = crate::common::octree_depth)]
     pub overlay_depth: Option<u32>,
     /// Start with pixel X,Y's ray tree inspected (from the top-left, from 0).
     #[arg(long, value_name = "X,Y", value_parser = parse_pixel)]
