@@ -194,14 +194,42 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let brute_tests = scene.shapes.len() as f64 * rays_total as f64;
         let every =
             ((brute_tests / args.brute_force_budget).ceil() as u32).clamp(1, settings.height);
-        let counted_off =
-            (!args.octree_only).then(|| pool.install(|| renderer_off.trace_rows(every, true)));
+        let (counted_off, counted_off_s) = timed(|| {
+            (!args.octree_only).then(|| pool.install(|| renderer_off.trace_rows(every, true)))
+        });
+        // A repeat renders about what the counted passes did (plus the
+        // counted octree pass again): enough to say how long the rest takes.
+        let rows_note = if every > 1 {
+            format!(" (rows 1/{every})")
+        } else {
+            String::new()
+        };
+        eprintln!(
+            "  counted passes: octree on {counted_s:.2} s{}; about {} left for this scene",
+            if args.octree_only {
+                String::new()
+            } else {
+                format!(", brute force {counted_off_s:.2} s{rows_note}")
+            },
+            duration_text(args.repeat as f64 * (2.0 * counted_s + counted_off_s))
+        );
 
         // Timed passes, interleaved so drift in machine speed hits both alike.
         let (mut full_on, mut rows_on, mut rows_off) = (Vec::new(), Vec::new(), Vec::new());
         let mut counted_times = vec![counted_s];
+        let repeats_started = std::time::Instant::now();
         for r in 0..args.repeat {
-            eprintln!("  repeat {}/{}", r + 1, args.repeat);
+            if r > 0 {
+                let per_repeat = repeats_started.elapsed().as_secs_f64() / r as f64;
+                eprintln!(
+                    "  repeat {}/{}: about {} left for this scene",
+                    r + 1,
+                    args.repeat,
+                    duration_text(per_repeat * (args.repeat - r) as f64)
+                );
+            } else {
+                eprintln!("  repeat 1/{}", args.repeat);
+            }
             full_on.push(timed(|| pool.install(|| renderer_on.render(false, None))).1);
             if r > 0 {
                 counted_times.push(timed(|| pool.install(|| renderer_on.render(true, None))).1);
@@ -430,7 +458,25 @@ fn sweep(args: &BenchArgs) -> Result<()> {
                 }
             }
         }
-        for (cost_driven, max_depth, leaf_size, max_duplication) in combinations {
+        let sweep_started = std::time::Instant::now();
+        let count = combinations.len();
+        for (k, (cost_driven, max_depth, leaf_size, max_duplication)) in
+            combinations.into_iter().enumerate()
+        {
+            let left = if k > 0 {
+                let per = sweep_started.elapsed().as_secs_f64() / k as f64;
+                format!(
+                    "; about {} left for this scene",
+                    duration_text(per * (count - k) as f64)
+                )
+            } else {
+                String::new()
+            };
+            eprintln!(
+                "  {}/{count}: depth {max_depth}, leaf {leaf_size}, duplication {max_duplication}, cost-driven {}{left}",
+                k + 1,
+                if cost_driven { "on" } else { "off" }
+            );
             let params = glint::accel::OctreeParams {
                 max_depth,
                 leaf_size,
@@ -580,4 +626,16 @@ fn bench_settings(args: &BenchArgs, scene: &mut glint::scene::Scene) -> RenderSe
     let mut settings = scene.render_settings();
     overrides.apply(&mut settings, &mut scene.octree_params);
     settings
+}
+
+/// "4 min 20 s", "12 s", "0.3 s": a time left as a person reads it.
+fn duration_text(seconds: f64) -> String {
+    if seconds < 10.0 {
+        format!("{seconds:.1} s")
+    } else if seconds < 60.0 {
+        format!("{seconds:.0} s")
+    } else {
+        let whole = seconds.round() as u64;
+        format!("{} min {} s", whole / 60, whole % 60)
+    }
 }
