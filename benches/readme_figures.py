@@ -96,6 +96,7 @@ def fmt(x, digits=2):
 
 
 def spd_table():
+    """SPD scenes at 512x512, octree on and off: the Benchmark table."""
     out = glint(
         "bench", *SPD_FILES, "--size", "512x512", "--samples", "1", "--repeat", "3",
         "--brute-force-budget", "2e9",
@@ -122,6 +123,7 @@ def spd_table():
 
 
 def spd_protocol():
+    """SPD scenes under --protocol spd, octree only."""
     rows = bench_json(*SPD_FILES, "--protocol", "spd", "--octree-only", "--repeat", "3")
     times = ", ".join(
         f"{os.path.basename(r['scene']).removesuffix('.nff')} {r['octree_on']['render_s']:.2f} s"
@@ -131,6 +133,7 @@ def spd_protocol():
 
 
 def scaling():
+    """The SPD size series: time against shape count."""
     files = (
         [f"scenes/spd/sizes/balls_s{k}.nff" for k in (1, 2, 3)]
         + ["scenes/spd/balls.nff", "scenes/spd/sizes/balls_s5.nff", "scenes/spd/sizes/tetra_s4.nff",
@@ -158,6 +161,7 @@ def scaling():
 
 
 def peers():
+    """glint against Embree 4 and Mitsuba 3 (benches/peers/run.sh)."""
     out = run(["bash", "benches/peers/run.sh", "2"])
     table = "\n".join(l for l in out.splitlines() if l.startswith("|"))
     return f"{table}\n\n{stamp('peers')}"
@@ -195,6 +199,7 @@ KERNEL_HISTORY = {
 
 
 def kernels():
+    """Instructions per ray (valgrind cachegrind) on three workloads."""
     workloads = [
         ("bunny primary rays, normals view, 256x192",
          ["scenes/bunny.toml", "--view", "normals", "--samples", "1"], 256, 192),
@@ -262,6 +267,7 @@ def psnr(a, b):
 
 
 def adaptive():
+    """scenes/default.toml at 800x600: AA off, adaptive, full."""
     scene = "scenes/default.toml"
     times = {
         aa: bench_json(scene, "--aa", aa, "--octree-only", "--repeat", "5")[0]["octree_on"]["render_s"]
@@ -286,6 +292,7 @@ def adaptive():
 
 
 def cost_view():
+    """Cost view figures on the teapot, and the view's overhead."""
     scene = "scenes/spd/teapot.nff"
     with tempfile.TemporaryDirectory() as d:
         cost = {}
@@ -317,6 +324,7 @@ def cost_view():
 
 
 def study():
+    """glint study: the speed-against-accuracy summary."""
     glint("study", "scenes/default.toml", "scenes/spd/balls.nff", "scenes/spd/tetra.nff",
           "scenes/spd/teapot.nff", "--out", "benches/study", "--size", "320x240", "--repeat", "3")
     with open(os.path.join(ROOT, "benches", "study", "study.md")) as f:
@@ -331,6 +339,7 @@ def study():
 
 
 def prediction():
+    """The octree cost prediction against the measured sweep."""
     sweep = glint("bench", *SPD_FILES, "--size", "512x512", "--samples", "1", "--repeat", "3",
                   "--sweep", "--sweep-depths", "6,8,10", "--sweep-leaf-sizes", "2,4,8",
                   "--format", "json")
@@ -359,19 +368,19 @@ SECTIONS = {
 
 def replace_block(text, name, body):
     pattern = re.compile(
-        rf"(<!-- figures:{re.escape(name)} -->\n).*?(\n<!-- /figures:{re.escape(name)} -->)",
+        rf"(<!-- figures:{re.escape(name)} -->\n)(?:.*?\n)?(<!-- /figures:{re.escape(name)} -->)",
         re.S,
     )
     if not pattern.search(text):
         sys.exit(f"readme_figures: README.md has no block `<!-- figures:{name} -->`")
-    return pattern.sub(lambda m: m.group(1) + body + m.group(2), text, count=1)
+    return pattern.sub(lambda m: m.group(1) + body + "\n" + m.group(2), text, count=1)
 
 
 def main():
     args = sys.argv[1:]
     if args == ["--list"]:
         for name, f in SECTIONS.items():
-            print(f"{name}: {f.__name__}")
+            print(f"{name}: {f.__doc__ or ''}".rstrip())
         return
     unknown = [a for a in args if a not in SECTIONS]
     if unknown:

@@ -412,7 +412,7 @@ mod tests {
             anti_aliasing: Some(AntiAliasing::Adaptive),
             octree: OctreeOverrides {
                 leaf_size: Some(9),
-                max_depth: Some(1000),
+                max_depth: Some(7),
                 ..OctreeOverrides::default()
             },
             ..Overrides::default()
@@ -422,7 +422,7 @@ mod tests {
         assert_eq!(settings.sides, Sides::Two, "an explicit choice wins");
         assert_eq!((settings.samples, settings.adaptive), (16, true));
         assert_eq!(params.leaf_size, 9);
-        assert_eq!(params.max_depth, crate::limits::MAX_OCTREE_DEPTH);
+        assert_eq!(params.max_depth, 7);
     }
 
     #[test]

@@ -776,6 +776,15 @@ fn an_nff_scene_is_saved_as_nff_and_what_it_cannot_hold_stays_unsaved() {
     let message = &h.state().messages().last().unwrap().text;
     assert!(message.contains("the reflectivity of f1"), "{message}");
     assert!(h.state().unsaved(), "the reflectivity is not in the file");
+
+    // Settings NFF has no place for stay marked too.
+    h.state_mut().scene_mut().materials[0].reflectivity = h.state().scene().materials[0].ks;
+    h.state_mut().settings_mut().samples = 16;
+    h.run_steps(2);
+    press(&mut h, Modifiers::COMMAND, Key::S);
+    let message = &h.state().messages().last().unwrap().text;
+    assert!(message.contains("samples"), "{message}");
+    assert!(h.state().unsaved(), "the samples are not in the file");
 }
 
 /// An OBJ opened on its own, its MTL material edited: "Save as" writes

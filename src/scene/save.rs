@@ -229,6 +229,9 @@ pub fn scene_nff(request: &SaveRequest) -> Result<SavedText, SaveError> {
         if new.reflectivity != new.ks {
             left_out.push(format!("the reflectivity of {} (NFF uses Ks)", old.name));
         }
+        // Every number of the material's `f` lines is written: the file's
+        // own may differ from the loaded value (an opaque material's index
+        // of refraction is often written 0 and loaded as 1).
         let values = [
             new.color.x,
             new.color.y,
@@ -240,20 +243,34 @@ pub fn scene_nff(request: &SaveRequest) -> Result<SavedText, SaveError> {
             new.ior,
         ];
         for entity in layout.materials.get(i).into_iter().flatten() {
-            for (r, (&a, &b)) in entity.iter().zip(values.iter().zip(&[
-                old.color.x,
-                old.color.y,
-                old.color.z,
-                old.kd,
-                old.ks,
-                old.shininess,
-                old.transparency,
-                old.ior,
-            ])) {
-                if a != b {
-                    edits.push((r.clone(), number(a)));
-                }
+            for (r, &x) in entity.iter().zip(&values) {
+                edits.push((r.clone(), number(x)));
             }
+        }
+    }
+    // NFF gives one material to equal `f` lines: materials edited to be
+    // equal are one material when the file is read again.
+    let nff_key = |m: &Material| {
+        [
+            m.color.x,
+            m.color.y,
+            m.color.z,
+            m.kd,
+            m.ks,
+            m.shininess,
+            m.transparency,
+            m.ior,
+        ]
+    };
+    for (i, a) in request.materials.iter().enumerate() {
+        if let Some(b) = request.materials[..i]
+            .iter()
+            .find(|b| nff_key(b) == nff_key(a))
+        {
+            left_out.push(format!(
+                "{} apart from {} (equal materials are one in NFF)",
+                a.name, b.name
+            ));
         }
     }
 
@@ -814,6 +831,47 @@ mod tests {
         assert_eq!(again.materials[0], materials[0]);
         assert_eq!(again.materials[1], loaded.materials[1]);
         assert_eq!(again.shape_materials, loaded.shape_materials);
+    }
+
+    #[test]
+    fn an_nff_material_made_transparent_gets_an_index_the_file_can_load() {
+        // Opaque SPD materials write their index of refraction as 0.
+        let text = "v\nfrom 0 -4 1\nat 0 0 0\nup 0 0 1\nangle 40\nhither 0.01\n\
+                    resolution 8 6\nl 4 -3 5\nf 1 1 1 0.5 0.5 45 0 0\ns 0 0 0 1\n\
+                    f 0 1 0 0.5 0.5 45 0 0\ns 2 0 0 1\n";
+        let path = Path::new("dir/balls.nff");
+        let loaded = load_str(text, path, &NoMeshes).unwrap();
+        let settings = loaded.render_settings();
+        let mut materials = loaded.materials.clone();
+        materials[0].transparency = 0.5;
+        let saved = scene_nff(&nff_request(
+            &loaded,
+            &loaded.camera,
+            &settings,
+            &loaded.lights,
+            &materials,
+        ))
+        .unwrap();
+        let again = load_str(&saved.text, path, &NoMeshes)
+            .unwrap_or_else(|e| panic!("{e}\n{}", saved.text));
+        assert_eq!(again.materials, materials);
+        assert!(saved.left_out.is_empty(), "{:?}", saved.left_out);
+
+        // Made equal, the two are one material when the file is read.
+        let mut equal = loaded.materials.clone();
+        equal[1].color = equal[0].color;
+        let saved = scene_nff(&nff_request(
+            &loaded,
+            &loaded.camera,
+            &settings,
+            &loaded.lights,
+            &equal,
+        ))
+        .unwrap();
+        assert_eq!(
+            saved.left_out,
+            ["f2 apart from f1 (equal materials are one in NFF)"]
+        );
     }
 
     #[test]

@@ -668,12 +668,32 @@ impl GlintApp {
                 // What the file holds is saved; edits it could not hold
                 // stay marked (the camera is compared as edited: an NFF
                 // angle may round the field of view in its last bit).
-                let reloaded = &self.edit.loaded;
+                let reloaded = Arc::clone(&self.edit.loaded);
                 if reloaded.lights.len() == baseline.lights.len() {
                     baseline.lights.clone_from(&reloaded.lights);
                 }
                 if reloaded.materials.len() == baseline.materials.len() {
                     baseline.materials.clone_from(&reloaded.materials);
+                } else if let Err(e) = self.install_scene((*reloaded).clone(), false) {
+                    // NFF made equal materials one: the saved scene, which
+                    // renders the same, is the one to go on editing.
+                    self.say(format!("cannot show the saved scene: {e:#}"), true);
+                } else {
+                    baseline = self.edit.snapshot();
+                }
+                // Settings the file cannot hold keep the file's value in
+                // the baseline, so they stay marked unsaved.
+                let file = reloaded.render_settings();
+                let b = &mut baseline.settings;
+                for what in &saved.left_out {
+                    match what.as_str() {
+                        "samples" => (b.samples, b.adaptive) = (file.samples, file.adaptive),
+                        "max depth" => b.max_depth = file.max_depth,
+                        "colours" => b.colors = file.colors,
+                        "sides" => b.sides = file.sides,
+                        "the octree switch" => b.use_octree = file.use_octree,
+                        _ => {}
+                    }
                 }
                 if saved.left_out.is_empty() {
                     self.say(format!("saved {}", shown.display()), false);

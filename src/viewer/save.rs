@@ -111,6 +111,9 @@ pub fn save(edit: &EditState, destination: &Path) -> anyhow::Result<Saved> {
     if builtin {
         write_builtin_mesh(destination)?;
     }
+    // The text must load before it replaces a file (the reload below then
+    // only confirms what was written).
+    crate::scene::load_str(&saved.text, destination, &crate::scene::FileSystem)?;
     crate::export::write_file_atomically(destination, saved.text.as_bytes())?;
     let scene = crate::scene::load(destination)?;
     Ok(Saved {

@@ -8,7 +8,7 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{Receiver, Sender, channel};
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, Weak};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
@@ -204,10 +204,14 @@ struct Shared {
 /// (its tests are what they show). The octree switch is part of the
 /// settings although the pixels do not depend on it: its time is what a
 /// user toggles it to see.
+///
+/// Scene and octree are held weakly: the cache does not keep an edited-away
+/// scene alive, and the allocation a weak pointer holds cannot be reused by
+/// another scene, so equal pointers are the same scene.
 #[derive(Clone)]
 struct PassKey {
-    scene: Arc<Scene>,
-    octree: Option<Arc<Octree>>,
+    scene: Weak<Scene>,
+    octree: Option<Weak<Octree>>,
     camera: CameraSpec,
     settings: RenderSettings,
     pass: crate::render::PassKind,
@@ -221,16 +225,23 @@ impl PassKey {
         if settings.view == ViewMode::AaNeed {
             settings.view = ViewMode::Shaded;
         }
+        // The aa-need view's grid pass traces 16 samples, whatever the
+        // setting (as the renderer does).
+        let grid = if job.settings.view == ViewMode::AaNeed {
+            16
+        } else {
+            job.settings.samples
+        };
         match pass {
             Engine::OneSample => (settings.samples, settings.adaptive) = (1, false),
-            Engine::Grid => (settings.samples, settings.adaptive) = (16, false),
-            Engine::Refine => (settings.samples, settings.adaptive) = (16, true),
+            Engine::Grid => (settings.samples, settings.adaptive) = (grid, false),
+            Engine::Refine => (settings.samples, settings.adaptive) = (grid, true),
             Engine::Corners => {}
         }
         let counts_tests = matches!(settings.view, ViewMode::Cost | ViewMode::CostSteps);
         PassKey {
-            scene: Arc::clone(&job.scene),
-            octree: counts_tests.then(|| Arc::clone(&job.octree)),
+            scene: Arc::downgrade(&job.scene),
+            octree: counts_tests.then(|| Arc::downgrade(&job.octree)),
             camera: job.camera,
             settings,
             pass,
@@ -238,9 +249,9 @@ impl PassKey {
     }
 
     fn matches(&self, other: &PassKey) -> bool {
-        Arc::ptr_eq(&self.scene, &other.scene)
+        Weak::ptr_eq(&self.scene, &other.scene)
             && match (&self.octree, &other.octree) {
-                (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+                (Some(a), Some(b)) => Weak::ptr_eq(a, b),
                 (None, None) => true,
                 _ => false,
             }
@@ -277,7 +288,9 @@ impl PassCache {
         if Self::bytes(&pass.frame) > Self::MAX_BYTES / 2 {
             return;
         }
-        self.entries.retain(|e| !e.key.matches(&pass.key));
+        // Passes of scenes nobody holds any more can never be asked for.
+        self.entries
+            .retain(|e| !e.key.matches(&pass.key) && e.key.scene.strong_count() > 0);
         self.entries.push(pass);
         let mut total: usize = self.entries.iter().map(|e| Self::bytes(&e.frame)).sum();
         while total > Self::MAX_BYTES {
@@ -544,11 +557,17 @@ fn show_cached(
             return false;
         };
         let mut records = vec![final_pass.record];
+        let one = (last != Engine::OneSample)
+            .then(|| cache.find(&PassKey::of(job, Engine::OneSample)))
+            .flatten();
+        if let Some(one) = one {
+            // The timing panel shows the 1-sample pass beside the last.
+            records.insert(0, one.record);
+        }
         let frame = if aa_need && last != Engine::OneSample {
-            let Some(one) = cache.find(&PassKey::of(job, Engine::OneSample)) else {
+            let Some(one) = one else {
                 return false;
             };
-            records.insert(0, one.record);
             Frame::aa_need(&one.frame, &final_pass.frame)
         } else {
             final_pass.frame.clone()
@@ -559,14 +578,14 @@ fn show_cached(
         return true;
     }
     if let Ok(mut history) = shared.history.lock() {
-        let now = shared.started.elapsed().as_secs_f64();
+        // `finished_at` stays the pass's own: the frame budget compares it
+        // with the last preview's.
         for r in records {
             history.push(PassRecord {
                 generation,
                 anti_aliasing: job.settings.samples > 1,
                 octree: job.settings.use_octree,
                 view: job.settings.view,
-                finished_at: now,
                 from_cache: true,
                 ..r
             });

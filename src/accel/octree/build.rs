@@ -28,6 +28,13 @@ impl Octree {
     /// aside and tested for every ray). Fails only if the allocator refuses
     /// memory; the budget in `params` normally keeps the build far from that.
     pub fn build(shapes: &[Shape], params: OctreeParams) -> Result<Self, OctreeError> {
+        // Past this level the walk's indices would wrap and answer wrongly;
+        // the other parameters only cost speed or memory when odd, and the
+        // edges (CLI, scene files, records) check them.
+        let deepest = crate::limits::MAX_OCTREE_DEPTH;
+        if params.max_depth > deepest {
+            return Err(crate::limits::LimitError::OctreeDepth(params.max_depth).into());
+        }
         let mut bounds = Aabb::EMPTY;
         let mut bounded = Vec::new();
         let mut unbounded = Vec::new();

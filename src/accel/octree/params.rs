@@ -88,6 +88,10 @@ pub enum OctreeError {
          lower the octree memory budget or switch the octree off"
     )]
     OutOfMemory { bytes: u64 },
+    /// A parameter outside [`crate::limits`] (a level past the deepest the
+    /// walk's indices hold would give wrong answers, not an error).
+    #[error(transparent)]
+    Limit(#[from] LimitError),
 }
 
 /// Machine-independent description of a built octree, with Havran's names:

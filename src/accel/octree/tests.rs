@@ -330,3 +330,21 @@ fn predicted_cost_is_what_random_lines_through_the_root_meet() {
     assert_eq!(one.traversal_steps_per_ray, 1.0);
     assert_eq!(one.intersection_tests_per_ray, shapes.len() as f64);
 }
+
+#[test]
+fn a_build_refuses_parameters_past_the_limits() {
+    let shapes = sphere_grid(2, 0.1);
+    let deepest = crate::limits::MAX_OCTREE_DEPTH;
+    let at = |max_depth| OctreeParams {
+        max_depth,
+        ..OctreeParams::default()
+    };
+    assert!(Octree::build(&shapes, at(deepest)).is_ok());
+    // Past it, the walk's level indices would wrap: an error, not a tree.
+    assert_eq!(
+        Octree::build(&shapes, at(deepest + 1)).err(),
+        Some(OctreeError::Limit(crate::limits::LimitError::OctreeDepth(
+            deepest + 1
+        )))
+    );
+}
