@@ -70,7 +70,7 @@ for label, measured, predicted in [
     print(
         f"- {label}: Spearman {spearman(m, p):.3f} over {len(rows)} settings "
         f"(within a scene: {min(per_scene):.2f} to {max(per_scene):.2f}); "
-        f"predicted/measured {min(ratios):.2f} to {max(ratios):.2f}"
+        f"predicted/measured {min(ratios):.3g} to {max(ratios):.3g}"
     )
 print()
 for scene in dict.fromkeys(r["scene"] for r in rows):

@@ -4,7 +4,9 @@
     cargo build --release
     python3 benches/readme_figures.py              # every section (about 40 minutes on 2 cores)
     python3 benches/readme_figures.py spd-table    # one or more sections
-    python3 benches/readme_figures.py --list       # the sections and their commands
+    python3 benches/readme_figures.py --list       # the sections and what they measure
+    python3 benches/readme_figures.py --reuse-sweep prediction
+                                                   # format the committed sweep again
 
 Each section runs glint's own commands (target/release/glint, never built
 here) and replaces the README's text between `<!-- figures:NAME -->` and
@@ -338,19 +340,32 @@ def study():
     return "\n".join(table) + f"\n\n{stamp('study')}"
 
 
+REUSE_SWEEP = False
+
+
 def prediction():
     """The octree cost prediction against the measured sweep."""
-    sweep = glint("bench", *SPD_FILES, "--size", "512x512", "--samples", "1", "--repeat", "3",
-                  "--sweep", "--sweep-depths", "6,8,10", "--sweep-leaf-sizes", "2,4,8",
-                  "--format", "json")
-    with open(os.path.join(ROOT, "benches", "prediction-sweep.json"), "w") as f:
-        f.write(sweep)
+    raw = os.path.join(ROOT, "benches", "prediction-sweep.json")
+    if REUSE_SWEEP:
+        # The committed sweep, formatted again (the sweep takes about 9 minutes).
+        with open(raw) as f:
+            sweep = f.read()
+        when = run(["git", "log", "-1", "--format=%cs", "--", "benches/prediction-sweep.json"]).strip()
+        made = (f"*Sweep measured {when} (benches/prediction-sweep.json), formatted by "
+                f"`python3 benches/readme_figures.py --reuse-sweep prediction`.*")
+    else:
+        sweep = glint("bench", *SPD_FILES, "--size", "512x512", "--samples", "1", "--repeat", "3",
+                      "--sweep", "--sweep-depths", "6,8,10", "--sweep-leaf-sizes", "2,4,8",
+                      "--format", "json")
+        with open(raw, "w") as f:
+            f.write(sweep)
+        made = stamp("prediction")
     out = run([sys.executable, "benches/prediction.py"], input=sweep)
     with open(os.path.join(ROOT, "benches", "prediction.md"), "w") as f:
         f.write(out)
     # The README quotes the summary tables; every row is in benches/prediction.md.
     tables = out.split("\n\n", 1)[1].strip()
-    return f"{tables}\n\n{stamp('prediction')}"
+    return f"{tables}\n\n{made}"
 
 
 SECTIONS = {
@@ -377,7 +392,11 @@ def replace_block(text, name, body):
 
 
 def main():
+    global REUSE_SWEEP
     args = sys.argv[1:]
+    if "--reuse-sweep" in args:
+        REUSE_SWEEP = True
+        args.remove("--reuse-sweep")
     if args == ["--list"]:
         for name, f in SECTIONS.items():
             print(f"{name}: {f.__doc__ or ''}".rstrip())
