@@ -72,6 +72,8 @@ pub fn check_scene(scene: &mut Scene) {
     let octree = match single_thread(|| Octree::build(&scene.shapes, scene.octree_params)) {
         Ok(o) => o,
         Err(OctreeError::OutOfMemory { .. }) => return,
+        // Loading checks the parameters: a loaded scene past them is a bug.
+        Err(e @ OctreeError::Limit(_)) => panic!("a loaded scene's octree parameters: {e}"),
     };
     let stats = octree.stats();
     // A split is taken only if it fits the budget; the slack is for the
