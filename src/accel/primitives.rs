@@ -79,7 +79,7 @@ impl<'a> Primitives<'a> {
             _ => {
                 for i in 0..N {
                     if lanes >> i & 1 == 1
-                        && let Some(hit) = self.intersect(index, &p.rays[i], probe[i])
+                        && let Some(hit) = self.intersect(index, &p.lane(i), probe[i])
                     {
                         let mut t = best.t;
                         let (mut b1, mut b2) = (best.b1, best.b2);
@@ -114,7 +114,7 @@ impl<'a> Primitives<'a> {
             _ => {
                 let mut blocked = 0;
                 for i in 0..N {
-                    if lanes >> i & 1 == 1 && self.intersect(index, &p.rays[i], t_max[i]).is_some()
+                    if lanes >> i & 1 == 1 && self.intersect(index, &p.lane(i), t_max[i]).is_some()
                     {
                         blocked |= 1 << i;
                     }

@@ -21,7 +21,7 @@ use crate::stats::{Counter, NoCounts, RayCounts, RenderCounts, WorkCounts};
 use super::adaptive::Signature;
 use super::integrator::ShadingPoint;
 use super::renderer::{Query, Renderer, Scratch};
-use super::tile_job::{PixelSum, TileJob, TileOutput};
+use super::tile_job::{PixelSum, TileJob, TileOutput, keep_scratch, spare_scratch};
 use super::tiles::Tile;
 
 /// Scratch space for a tile's packets: the walk's stack and each lane's
@@ -49,12 +49,9 @@ impl LaneWork for PacketTile<'_, '_> {
             signatures: Vec::new(),
             counts: RenderCounts::default(),
         };
-        let mut scratch = Scratch::default();
-        let mut stack = PacketScratch::<N> {
-            walk: PacketStack::default(),
-            crossings: std::array::from_fn(|_| ShadowCrossings::default()),
-        };
         let r = self.renderer;
+        let mut scratch = spare_scratch::<Scratch>();
+        let mut stack = spare_scratch::<PacketScratch<N>>();
         if self.count_work {
             let mut work = WorkCounts::default();
             let mut query = Query {
@@ -70,7 +67,18 @@ impl LaneWork for PacketTile<'_, '_> {
             };
             r.fill_tile_lanes::<_, N>(self.job, self.tile, &mut query, &mut stack, &mut out);
         }
+        keep_scratch(stack);
+        keep_scratch(scratch);
         out
+    }
+}
+
+impl<const N: usize> Default for PacketScratch<N> {
+    fn default() -> Self {
+        Self {
+            walk: PacketStack::default(),
+            crossings: std::array::from_fn(|_| ShadowCrossings::default()),
+        }
     }
 }
 
@@ -198,10 +206,7 @@ impl Renderer<'_> {
         recs: &mut [R; N],
     ) -> [DVec3; N] {
         counts.rays.primary += rays.len() as u64;
-        let prepared: [PreparedRay; N] =
-            std::array::from_fn(|k| PreparedRay::new(rays[k.min(rays.len() - 1)]));
-        let prepared = &prepared[..rays.len()];
-        let hits = self.closest_lanes::<C, N>(prepared, query, stack);
+        let hits = self.closest_lanes::<C, N>(rays, query, stack);
         let mut values = if self.settings.view.traces_shading() {
             self.shade_lanes(rays, &hits, query, stack, &mut counts.rays, recs)
         } else {
@@ -227,12 +232,12 @@ impl Renderer<'_> {
     #[inline(always)]
     fn closest_lanes<C: Counter, const N: usize>(
         &self,
-        rays: &[PreparedRay],
+        rays: &[Ray],
         query: &mut Query<C>,
         stack: &mut PacketScratch<N>,
     ) -> [Option<ClosestHit>; N] {
         if self.settings.use_octree
-            && let Some(packet) = RayPacket::<N>::new(rays)
+            && let Some(packet) = RayPacket::<N>::from_rays(rays)
         {
             let prims = self.primitives();
             let best = self.octree.closest_packet(
@@ -255,7 +260,7 @@ impl Renderer<'_> {
         }
         std::array::from_fn(|k| {
             if k < rays.len() {
-                self.closest(&rays[k], query)
+                self.closest(&PreparedRay::new(rays[k]), query)
             } else {
                 None
             }
@@ -363,13 +368,13 @@ impl Renderer<'_> {
     ) -> [f64; N] {
         let mut passes = [1.0; N];
         let mut lanes = [0usize; N];
-        let mut rays = [PreparedRay::new(Ray::new(DVec3::ZERO, DVec3::X)); N];
+        let mut rays = [Ray::new(DVec3::ZERO, DVec3::X); N];
         let mut lengths = [0.0; N];
         let mut n = 0;
         for k in 0..N {
             if let Some((l, distance, _)) = toward[k] {
                 lanes[n] = k;
-                rays[n] = PreparedRay::new(Ray::new(origins[k], l));
+                rays[n] = Ray::new(origins[k], l);
                 lengths[n] = distance;
                 n += 1;
             }
@@ -379,7 +384,7 @@ impl Renderer<'_> {
             return passes;
         }
         if self.settings.use_octree
-            && let Some(packet) = RayPacket::<N>::new(&rays[..n])
+            && let Some(packet) = RayPacket::<N>::from_rays(&rays[..n])
         {
             let prims = self.primitives();
             let found = &mut stack.crossings;
@@ -401,7 +406,7 @@ impl Renderer<'_> {
             return passes;
         }
         for (m, &k) in lanes[..n].iter().enumerate() {
-            passes[k] = self.transmittance(&rays[m], lengths[m], query);
+            passes[k] = self.transmittance(&PreparedRay::new(rays[m]), lengths[m], query);
         }
         passes
     }

@@ -11,7 +11,7 @@ use crate::stats::{Counter, NoCounts, RayCounts, RenderCounts, WorkCounts};
 
 use super::adaptive::Signature;
 use super::renderer::{Query, Renderer, Scratch};
-use super::tile_job::{PixelSum, TileJob, TileOutput};
+use super::tile_job::{PixelSum, TileJob, TileOutput, keep_scratch, spare_scratch};
 use super::tiles::Tile;
 
 impl Renderer<'_> {
@@ -33,23 +33,35 @@ impl Renderer<'_> {
             signatures: Vec::new(),
             counts: RenderCounts::default(),
         };
-        let mut scratch = Scratch::default();
+        let mut scratch = spare_scratch::<Scratch>();
+        self.fill_tile_counting(job, tile, count_work, &mut scratch, &mut out);
+        keep_scratch(scratch);
+        out
+    }
+
+    fn fill_tile_counting(
+        &self,
+        job: TileJob,
+        tile: Tile,
+        count_work: bool,
+        scratch: &mut Scratch,
+        out: &mut TileOutput,
+    ) {
         if count_work {
             let mut work = WorkCounts::default();
             let mut query = Query {
                 counter: &mut work,
-                scratch: &mut scratch,
+                scratch,
             };
-            self.fill_tile(job, tile, &mut query, &mut out);
+            self.fill_tile(job, tile, &mut query, out);
             out.counts.work = work;
         } else {
             let mut query = Query {
                 counter: &mut NoCounts,
-                scratch: &mut scratch,
+                scratch,
             };
-            self.fill_tile(job, tile, &mut query, &mut out);
+            self.fill_tile(job, tile, &mut query, out);
         }
-        out
     }
 
     fn fill_tile<C: Counter>(

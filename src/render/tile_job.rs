@@ -62,3 +62,31 @@ impl PixelSum {
         }
     }
 }
+
+thread_local! {
+    /// Scratch space (walk stacks, shadow crossings) left by this thread's
+    /// earlier tiles. Setting it up is tens of kilobytes of stores, more
+    /// than the walks of a 1-sample tile's rays cost in the pass
+    /// measured (bunny, normals view); kept, it is set up once per thread.
+    static SPARE_SCRATCH: std::cell::RefCell<Vec<Box<dyn std::any::Any>>> =
+        const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// Scratch space of type `T` this thread used before, or a new one; give
+/// it back with [`keep_scratch`]. Scratch holds nothing a query reads
+/// before writing, so the pixels do not depend on its past. (No closure:
+/// the packet path's tile loop must stay inlined into the function
+/// compiled for the SIMD level.)
+pub(super) fn spare_scratch<T: Default + 'static>() -> Box<T> {
+    SPARE_SCRATCH
+        .with_borrow_mut(|spare| {
+            let i = spare.iter().position(|s| s.is::<T>())?;
+            spare.swap_remove(i).downcast::<T>().ok()
+        })
+        .unwrap_or_default()
+}
+
+/// Keeps `scratch` for this thread's next tile.
+pub(super) fn keep_scratch<T: 'static>(scratch: Box<T>) {
+    SPARE_SCRATCH.with_borrow_mut(|spare| spare.push(scratch));
+}

@@ -30,17 +30,7 @@ pub struct PreparedRay {
 impl PreparedRay {
     pub fn new(ray: Ray) -> Self {
         let d = ray.dir;
-        let a = d.abs();
-        // The dominant axis, and whether the direction is negative along
-        // it: one of six permutations, each with constant axes below (a
-        // vector indexed by a variable costs a match per access).
-        let permutation = if a.x >= a.y && a.x >= a.z {
-            (d.x < 0.0) as u8
-        } else if a.y >= a.z {
-            2 + (d.y < 0.0) as u8
-        } else {
-            4 + (d.z < 0.0) as u8
-        };
+        let permutation = Self::permutation_of(d);
         let shear = match permutation {
             0 => DVec3::new(d.y / d.x, d.z / d.x, 1.0 / d.x),
             1 => DVec3::new(d.z / d.x, d.y / d.x, 1.0 / d.x),
@@ -68,6 +58,21 @@ impl PreparedRay {
             parallel,
             permutation,
             shear,
+        }
+    }
+
+    /// The dominant axis of `d`, and whether the direction is negative
+    /// along it: one of six permutations, each with constant axes (a
+    /// vector indexed by a variable costs a match per access).
+    #[inline(always)]
+    pub(super) fn permutation_of(d: DVec3) -> u8 {
+        let a = d.abs();
+        if a.x >= a.y && a.x >= a.z {
+            (d.x < 0.0) as u8
+        } else if a.y >= a.z {
+            2 + (d.y < 0.0) as u8
+        } else {
+            4 + (d.z < 0.0) as u8
         }
     }
 

@@ -11,15 +11,16 @@
 use super::hit::PreparedRay;
 use super::sphere::Sphere;
 use super::triangle::Triangle;
+use crate::math::{DVec3, Ray};
 use crate::simd::{F64s, lanes, map2, mask, per_axis, splat};
 
 /// Up to `N` rays that share their direction's signs and the watertight
 /// test's axis permutation, and none of which is parallel to an axis plane
 /// (the octree walk and the triangle test then treat every lane alike).
+/// Each lane holds what [`PreparedRay::new`] computes for its ray, computed
+/// in lanes with the same operations.
 #[derive(Clone, Copy, Debug)]
 pub struct RayPacket<const N: usize> {
-    /// Each lane's ray, for the tests that run lane by lane.
-    pub rays: [PreparedRay; N],
     /// Lanes holding a ray (the others repeat lane 0 and are never live).
     pub live: u32,
     pub origin: [F64s<N>; 3],
@@ -36,32 +37,88 @@ impl<const N: usize> RayPacket<N> {
     /// or permutation or one is parallel to an axis plane: such rays are
     /// traced one by one.
     #[inline(always)]
-    pub fn new(rays: &[PreparedRay]) -> Option<Self> {
+    pub fn from_rays(rays: &[Ray]) -> Option<Self> {
         let first = rays.first()?;
-        if rays.len() > N
-            || rays.iter().any(|r| {
-                r.parallel != 0
-                    || r.negative != first.negative
-                    || r.permutation != first.permutation
-            })
-        {
+        if rays.len() > N {
             return None;
         }
-        let lanes: [PreparedRay; N] = std::array::from_fn(|i| *rays.get(i).unwrap_or(first));
-        let component = |f: &dyn Fn(&PreparedRay) -> [f64; 3]| -> [F64s<N>; 3] {
-            std::array::from_fn(|k| std::array::from_fn(|i| f(&lanes[i])[k]))
+        let ray = |i: usize| rays.get(i).unwrap_or(first);
+        let origin: [F64s<N>; 3] = per_axis!(|k| lanes!(N, |i| ray(i).origin[k]));
+        let dir: [F64s<N>; 3] = per_axis!(|k| lanes!(N, |i| ray(i).dir[k]));
+        let inv_dir: [F64s<N>; 3] = per_axis!(|k| lanes!(N, |i| 1.0 / dir[k][i]));
+        let all = crate::simd::all_lanes::<N>();
+        let zero = splat::<N>(0.0);
+        let infinity = splat::<N>(f64::INFINITY);
+        let mut negative = 0;
+        for k in 0..3 {
+            // `PreparedRay::new` treats a component whose reciprocal is not
+            // finite as parallel: packets take none.
+            let magnitude: F64s<N> = lanes!(N, |i| inv_dir[k][i].abs());
+            if mask(magnitude, infinity, |m, inf| m < inf) != all {
+                return None;
+            }
+            match mask(dir[k], zero, |d, z| d < z) {
+                0 => {}
+                m if m == all => negative |= 1 << k,
+                _ => return None,
+            }
+        }
+        let permutation = PreparedRay::permutation_of(first.dir);
+        if (1..rays.len()).any(|i| PreparedRay::permutation_of(rays[i].dir) != permutation) {
+            return None;
+        }
+        let shear = match permutation {
+            0 => shear_along::<1, 2, 0, N>(&dir, &inv_dir),
+            1 => shear_along::<2, 1, 0, N>(&dir, &inv_dir),
+            2 => shear_along::<2, 0, 1, N>(&dir, &inv_dir),
+            3 => shear_along::<0, 2, 1, N>(&dir, &inv_dir),
+            4 => shear_along::<0, 1, 2, N>(&dir, &inv_dir),
+            _ => shear_along::<1, 0, 2, N>(&dir, &inv_dir),
         };
         Some(Self {
-            origin: component(&|r| r.ray.origin.to_array()),
-            dir: component(&|r| r.ray.dir.to_array()),
-            inv_dir: component(&|r| r.inv_dir),
-            shear: component(&|r| r.shear.to_array()),
-            rays: lanes,
-            live: crate::simd::all_lanes::<N>() >> (N - rays.len()),
-            negative: first.negative,
-            permutation: first.permutation,
+            live: all >> (N - rays.len()),
+            origin,
+            dir,
+            inv_dir,
+            shear,
+            negative,
+            permutation,
         })
     }
+
+    /// Lane `i` as a single prepared ray (bit for bit what
+    /// [`PreparedRay::new`] gives for it), for the tests that run lane by
+    /// lane.
+    #[inline(always)]
+    pub fn lane(&self, i: usize) -> PreparedRay {
+        let column = |v: &[F64s<N>; 3]| [v[0][i], v[1][i], v[2][i]];
+        PreparedRay {
+            ray: Ray {
+                origin: DVec3::from(column(&self.origin)),
+                dir: DVec3::from(column(&self.dir)),
+            },
+            inv_dir: column(&self.inv_dir),
+            negative: self.negative,
+            parallel: 0,
+            permutation: self.permutation,
+            shear: DVec3::from(column(&self.shear)),
+        }
+    }
+}
+
+/// The watertight test's shear constants in lanes for the permutation
+/// `(KX, KY, KZ)`: `d[KX] / d[KZ]`, `d[KY] / d[KZ]` and `1 / d[KZ]`, as in
+/// [`PreparedRay::new`].
+#[inline(always)]
+fn shear_along<const KX: usize, const KY: usize, const KZ: usize, const N: usize>(
+    dir: &[F64s<N>; 3],
+    inv_dir: &[F64s<N>; 3],
+) -> [F64s<N>; 3] {
+    [
+        map2(dir[KX], dir[KZ], |a, b| a / b),
+        map2(dir[KY], dir[KZ], |a, b| a / b),
+        inv_dir[KZ],
+    ]
 }
 
 /// Per lane, the closest hit so far: its parameter (the limit beyond which

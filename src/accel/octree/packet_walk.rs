@@ -114,11 +114,11 @@ impl<C: Counter, const N: usize> PacketVisitor<N> for Shadowed<'_, C, N> {
             // shadow ray does.
             for i in 0..N {
                 if lanes >> i & 1 == 1 {
-                    let ray = &self.packet.rays[i];
+                    let ray = self.packet.lane(i);
                     test_occlusion(
                         self.prims,
                         index,
-                        ray,
+                        &ray,
                         self.t_max[i],
                         &mut self.found[i],
                         self.counter,
