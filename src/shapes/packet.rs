@@ -339,3 +339,90 @@ impl Sphere {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bits(r: &PreparedRay) -> (Vec<u64>, u32, u32, u8) {
+        let mut v: Vec<u64> = r.inv_dir.iter().map(|x| x.to_bits()).collect();
+        v.extend(r.shear.to_array().iter().map(|x| x.to_bits()));
+        v.extend(r.ray.origin.to_array().iter().map(|x| x.to_bits()));
+        v.extend(r.ray.dir.to_array().iter().map(|x| x.to_bits()));
+        (v, r.negative, r.parallel, r.permutation)
+    }
+
+    /// Directions around `base` (small, deterministic perturbations), so
+    /// that they mostly share signs and permutation.
+    fn rays_around(base: DVec3, seed: u64, n: usize) -> Vec<Ray> {
+        let mut state = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        (0..n)
+            .map(|_| {
+                let origin = DVec3::new(next() * 1e3, next() * 1e-3, next());
+                let dir = (base + 0.3 * DVec3::new(next(), next(), next())).normalize();
+                Ray::new(origin, dir)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn each_lane_is_the_prepared_single_ray_bit_for_bit() {
+        let mut packets = 0;
+        for (b, base) in [
+            DVec3::new(1.0, 0.2, 0.1),
+            DVec3::new(-1.0, 0.3, -0.2),
+            DVec3::new(0.2, 1.0, 0.3),
+            DVec3::new(0.1, -1.0, 0.4),
+            DVec3::new(0.3, 0.2, 1.0),
+            DVec3::new(-0.2, 0.1, -1.0),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            for seed in 0..64 {
+                let rays = rays_around(base, seed * 7 + b as u64, 1 + seed as usize % 4);
+                let Some(packet) = RayPacket::<4>::from_rays(&rays) else {
+                    // Then the rays really disagree in signs or permutation.
+                    let first = PreparedRay::new(rays[0]);
+                    assert!(rays.iter().any(|r| {
+                        let p = PreparedRay::new(*r);
+                        p.negative != first.negative || p.permutation != first.permutation
+                    }));
+                    continue;
+                };
+                packets += 1;
+                assert_eq!(packet.live, (1 << rays.len()) - 1);
+                for (i, ray) in rays.iter().enumerate() {
+                    assert_eq!(bits(&packet.lane(i)), bits(&PreparedRay::new(*ray)));
+                }
+            }
+        }
+        assert!(packets > 200, "most groups form packets ({packets})");
+    }
+
+    #[test]
+    fn rays_that_disagree_or_are_parallel_form_no_packet() {
+        let o = DVec3::ZERO;
+        let right = Ray::new(o, DVec3::new(1.0, 0.1, 0.1).normalize());
+        let left = Ray::new(o, DVec3::new(-1.0, 0.1, 0.1).normalize());
+        let up = Ray::new(o, DVec3::new(0.1, 1.0, 0.1).normalize());
+        let flat = Ray::new(o, DVec3::new(1.0, 0.0, 0.1).normalize());
+        assert!(RayPacket::<4>::from_rays(&[right, left]).is_none(), "signs");
+        assert!(RayPacket::<4>::from_rays(&[right, up]).is_none(), "axes");
+        assert!(
+            RayPacket::<4>::from_rays(&[right, flat]).is_none(),
+            "parallel"
+        );
+        assert!(RayPacket::<4>::from_rays(&[right; 5]).is_none(), "too many");
+        assert!(RayPacket::<4>::from_rays(&[]).is_none());
+        assert!(RayPacket::<4>::from_rays(&[right, right]).is_some());
+    }
+}
