@@ -73,6 +73,7 @@ impl Renderer<'_> {
     }
 
     /// The hit `hit` of `ray` resolved for shading, told to `rec`.
+    #[inline(always)]
     pub(super) fn shading_point_at<R: RayRecorder>(
         &self,
         ray: &Ray,

@@ -69,7 +69,7 @@ pub struct Scene {
     /// not copy a million triangles.
     pub shapes: Arc<Vec<Shape>>,
     pub shape_materials: Arc<Vec<u32>>,
-    /// Per-triangle vertex normals of smooth-shaded triangles.
+    /// Per-triangle vertex normals of smooth-shaded triangles, unit length.
     pub vertex_normals: Arc<Vec<[DVec3; 3]>>,
     /// Degenerate triangles dropped while loading (they could never be hit).
     pub dropped_triangles: usize,
@@ -247,8 +247,11 @@ impl Scene {
             self.dropped_triangles += 1;
             return;
         };
-        if let Some(n) = normals
-            && n.iter().all(|v| v.is_finite() && v.length_squared() > 0.0)
+        // Stored as unit vectors: shading reads them at every hit
+        // (Triangle::smooth_point needs each one unit) and normalizing
+        // once here spares three square roots and divisions per hit.
+        if let Some(n) = normals.map(|n| n.map(DVec3::normalize_or_zero))
+            && n.iter().all(|v| *v != DVec3::ZERO)
         {
             t.vertex_normals = self.vertex_normals.len() as u32;
             Arc::make_mut(&mut self.vertex_normals).push(n);
@@ -381,4 +384,42 @@ pub(super) fn line_column(text: &str, offset: usize) -> (usize, usize) {
     let line = before.matches('\n').count() + 1;
     let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
     (line, column)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn empty() -> Scene {
+        let camera = CameraSpec {
+            eye: DVec3::new(0.0, 0.0, 10.0),
+            lookat: DVec3::ZERO,
+            up: DVec3::Y,
+            fov: 40.0,
+        };
+        Scene::empty("normals".into(), camera, ImageSettings::default())
+    }
+
+    /// Shading reads vertex normals as unit vectors, whatever length the
+    /// file gave them; normals with no direction leave the triangle flat.
+    #[test]
+    fn vertex_normals_are_stored_unit_length() {
+        let triangle = [DVec3::ZERO, DVec3::X, DVec3::Y];
+        let lengths = [1e-150, 1e-3, 1.0, 7.5, 1e150];
+        let mut scene = empty();
+        let normals = lengths.map(|s| [DVec3::new(0.0, 0.6, 0.8) * s; 3]);
+        scene.push_mesh(vec![triangle; lengths.len()], Some(normals.to_vec()), |_| 0);
+        assert_eq!(scene.vertex_normals.len(), lengths.len());
+        for n in scene.vertex_normals.iter().flatten() {
+            assert!((n.length() - 1.0).abs() < 1e-15, "{n}");
+            assert!((*n - DVec3::new(0.0, 0.6, 0.8)).length() < 1e-15, "{n}");
+        }
+        let mut scene = empty();
+        for bad in [DVec3::ZERO, DVec3::splat(f64::NAN), DVec3::splat(1e300)] {
+            scene.push_mesh(vec![triangle], Some(vec![[DVec3::Z, bad, DVec3::Z]]), |_| 0);
+        }
+        assert!(scene.vertex_normals.is_empty());
+        assert_eq!(scene.shapes.len(), 3);
+        assert!(scene.shapes.iter().all(|s| !s.has_vertex_normals()));
+    }
 }

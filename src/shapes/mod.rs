@@ -128,6 +128,7 @@ impl Shape {
     }
 
     /// The surface point of a hit found by [`Shape::intersect`] with `ray`.
+    #[inline(always)]
     pub fn surface(&self, ray: &Ray, hit: &ShapeHit, vertex_normals: &[[DVec3; 3]]) -> Surface {
         match self {
             Shape::Sphere(s) => s.surface(ray, hit),

@@ -98,6 +98,7 @@ impl Triangle {
         })
     }
 
+    #[inline(always)]
     pub fn surface(&self, hit: &ShapeHit, vertex_normals: &[[DVec3; 3]]) -> Surface {
         let b0 = 1.0 - hit.b1 - hit.b2;
         let [v0, v1, v2] = self.vertices;
@@ -132,6 +133,7 @@ impl Triangle {
     /// "Hacking the shadow terminator", Ray Tracing Gems II, 2021: each
     /// vertex's tangent plane lifts the point by how far it lies below it,
     /// and the lifts are blended by the barycentric coordinates).
+    #[inline(always)]
     pub fn smooth_point(
         &self,
         hit: &ShapeHit,
@@ -145,7 +147,8 @@ impl Triangle {
         let weights = [1.0 - hit.b1 - hit.b2, hit.b1, hit.b2];
         let mut lift = DVec3::ZERO;
         for k in 0..3 {
-            let n = normals[k].normalize_or_zero();
+            // The scene stores vertex normals as unit vectors.
+            let n = normals[k];
             let n = if n.dot(side) < 0.0 { -n } else { n };
             let below = (self.vertices[k] - point).dot(n);
             if below > 0.0 {
