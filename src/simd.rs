@@ -214,16 +214,6 @@ pub fn mask<const N: usize>(a: F64s<N>, b: F64s<N>, f: impl Fn(f64, f64) -> bool
     m
 }
 
-/// Bit `i` set where `a[i] <= min(b[i], c[i])`: a lane's interval
-/// `[a, b]` is not empty and starts before its limit `c` (for values that
-/// are never NaN). One comparison, so one vector compare and move-mask:
-/// LLVM vectorizes a single comparison reliably, a combination of several
-/// poorly.
-#[inline(always)]
-pub fn open_before<const N: usize>(a: F64s<N>, b: F64s<N>, c: F64s<N>) -> u32 {
-    mask(a, min(b, c), |x, y| x <= y)
-}
-
 /// The lanes a mask of `N` lanes can hold.
 #[inline(always)]
 pub fn all_lanes<const N: usize>() -> u32 {

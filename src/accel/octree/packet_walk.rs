@@ -13,18 +13,18 @@
 // Lane loops index several arrays by the same lane number.
 #![allow(clippy::needless_range_loop)]
 
-use super::node::LEVEL_MASK;
-use super::node::Node;
+use super::node::{LEVEL_MASK, Node, child_corner};
 use super::tree::Octree;
 use crate::accel::primitives::{Primitives, ShadowCrossings, test_occlusion};
 use crate::limits::MAX_OCTREE_DEPTH;
 use crate::shapes::{PacketHits, RayPacket};
-use crate::simd::{F64s, lanes, mask, max, min, open_before, per_axis};
+use crate::simd::{F64s, lanes, mask, max, min, per_axis};
 use crate::stats::Counter;
 
 /// A cell waiting on a packet's stack: its corner, node and level, and
 /// each lane's parameters at its entry and exit (empty where the lane's
-/// ray misses it).
+/// ray misses it; the exit no later than the lane's limit when the cell
+/// was pushed).
 #[derive(Clone, Copy, Debug)]
 struct PacketEntry<const N: usize> {
     min: [f64; 3],
@@ -264,8 +264,9 @@ impl Octree {
         while top > 0 {
             top -= 1;
             let e = entries[top];
-            let limit = visitor.limit();
-            let active = open_before(e.t0, e.t1, limit) & p.live;
+            // A lane's exit, no later than its limit (which only falls).
+            let t1 = min(e.t1, visitor.limit());
+            let active = mask(e.t0, t1, |a, b| a <= b) & p.live;
             if active == 0 {
                 continue;
             }
@@ -286,11 +287,41 @@ impl Octree {
             let h = self.sides[(e.level + 1) as usize & LEVEL_MASK];
             let mid = [e.min[0] + h, e.min[1] + h, e.min[2] + h];
             let t_mid: [F64s<N>; 3] = per_axis!(|k| lanes!(N, |i| (mid[k] - o[k][i]) * inv[k][i]));
+            // Each octant's interval, by its far bits (bit k: past the
+            // mid-plane of axis k along the rays): it starts where the last
+            // of its far mid-planes is crossed and ends where the first of
+            // the others is. Octants share the partial minima and maxima
+            // (exact operations, so any grouping gives the same values).
+            let t0 = e.t0;
+            let after: [F64s<N>; 3] = per_axis!(|k| max(t0, t_mid[k]));
+            let before: [F64s<N>; 3] = per_axis!(|k| min(t1, t_mid[k]));
+            let after01 = max(after[0], after[1]);
+            let before01 = min(before[0], before[1]);
+            let enter = [
+                t0,
+                after[0],
+                after[1],
+                after01,
+                after[2],
+                max(after[0], after[2]),
+                max(after[1], after[2]),
+                max(after01, after[2]),
+            ];
+            let leave = [
+                min(before01, before[2]),
+                min(before[1], before[2]),
+                min(before[0], before[2]),
+                before[2],
+                before01,
+                before[1],
+                before[0],
+                t1,
+            ];
             let cell = Cell {
                 e: &e,
-                h,
-                t_mid: &t_mid,
-                limit: &limit,
+                mid,
+                enter: &enter,
+                leave: &leave,
                 active,
                 negative: p.negative,
                 node_mask: node.mask(),
@@ -313,11 +344,11 @@ impl Octree {
 /// An interior cell being split for a packet.
 struct Cell<'a, const N: usize> {
     e: &'a PacketEntry<N>,
-    /// The children's side.
-    h: f64,
-    /// Each lane's parameter at the three mid-planes.
-    t_mid: &'a [F64s<N>; 3],
-    limit: &'a F64s<N>,
+    /// The mid-planes, where the upper children start.
+    mid: [f64; 3],
+    /// Each octant's entry and exit per lane, by its far bits.
+    enter: &'a [F64s<N>; 8],
+    leave: &'a [F64s<N>; 8],
     active: u32,
     negative: u32,
     node_mask: u32,
@@ -326,9 +357,7 @@ struct Cell<'a, const N: usize> {
 
 impl<const N: usize> Cell<'_, N> {
     /// Pushes the child whose far bits are `FAR` (bit k: past the mid-plane
-    /// of axis k along the rays) if a lane enters it before its limit: past
-    /// a mid-plane the child starts where the ray crosses it; before it, it
-    /// ends there.
+    /// of axis k along the rays) if a lane enters it before its limit.
     #[inline(always)]
     fn push<const FAR: u32, V: PacketVisitor<N>>(
         &self,
@@ -336,16 +365,8 @@ impl<const N: usize> Cell<'_, N> {
         top: &mut usize,
         visitor: &mut V,
     ) {
-        let mut c0 = self.e.t0;
-        let mut c1 = self.e.t1;
-        for k in 0..3 {
-            if FAR >> k & 1 == 1 {
-                c0 = max(c0, self.t_mid[k]);
-            } else {
-                c1 = min(c1, self.t_mid[k]);
-            }
-        }
-        let inside = open_before(c0, c1, *self.limit) & self.active;
+        let (c0, c1) = (self.enter[FAR as usize], self.leave[FAR as usize]);
+        let inside = mask(c0, c1, |a, b| a <= b) & self.active;
         if inside == 0 {
             return;
         }
@@ -357,14 +378,9 @@ impl<const N: usize> Cell<'_, N> {
             visitor.counter().add_lanes(0, n, n);
             return;
         }
-        let (e, h) = (self.e, self.h);
-        let bit = |k: usize| (c >> k & 1) as f64;
+        let e = self.e;
         entries[*top] = PacketEntry {
-            min: [
-                e.min[0] + h * bit(0),
-                e.min[1] + h * bit(1),
-                e.min[2] + h * bit(2),
-            ],
+            min: child_corner(e.min, self.mid, c),
             t0: c0,
             t1: c1,
             node: self.first_child.child(c),

@@ -2,7 +2,7 @@
 //! Ureña & Lastra (2000), iteratively on a per-thread stack, for the
 //! closest hit and for shadow rays.
 
-use super::node::LEVEL_MASK;
+use super::node::{LEVEL_MASK, child_corner};
 use super::tree::Octree;
 use crate::accel::primitives::{
     ClosestHit, Primitives, ShadowCrossings, test_closest, test_occlusion,
@@ -220,12 +220,7 @@ impl Octree {
             let mask = node.mask();
             for i in (0..=n).rev() {
                 let c = children[i];
-                let bit = |k: usize| (c >> k & 1) as f64;
-                let min = [
-                    e.min[0] + h * bit(0),
-                    e.min[1] + h * bit(1),
-                    e.min[2] + h * bit(2),
-                ];
+                let min = child_corner(e.min, mid, c);
                 if mask >> c & 1 == 0 {
                     if times[i] <= limit {
                         visitor.counter().traversal_step();
