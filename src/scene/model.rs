@@ -250,9 +250,8 @@ impl Scene {
         // Stored as unit vectors: shading reads them at every hit
         // (Triangle::smooth_point needs each one unit) and normalizing
         // once here spares three square roots and divisions per hit.
-        if let Some(n) = normals.map(|n| n.map(DVec3::normalize_or_zero))
-            && n.iter().all(|v| *v != DVec3::ZERO)
-        {
+        if let Some([Some(a), Some(b), Some(c)]) = normals.map(|n| n.map(unit_normal)) {
+            let n = [a, b, c];
             t.vertex_normals = self.vertex_normals.len() as u32;
             Arc::make_mut(&mut self.vertex_normals).push(n);
         }
@@ -386,6 +385,24 @@ pub(super) fn line_column(text: &str, offset: usize) -> (usize, usize) {
     (line, column)
 }
 
+/// `v` as a unit vector; `None` where it has no direction (zero, or not
+/// finite). A vector whose squared length overflows or underflows (a
+/// normal 1e200 or 1e-200 long) is scaled by its largest component first,
+/// so it keeps its direction; any other is normalized as it is.
+fn unit_normal(v: DVec3) -> Option<DVec3> {
+    let largest = v.abs().max_element();
+    if !(largest > 0.0 && largest.is_finite()) {
+        return None;
+    }
+    let v = if v.length_squared().is_normal() {
+        v
+    } else {
+        v / largest
+    };
+    let n = v.normalize_or_zero();
+    (n != DVec3::ZERO).then_some(n)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -401,11 +418,12 @@ mod tests {
     }
 
     /// Shading reads vertex normals as unit vectors, whatever length the
-    /// file gave them; normals with no direction leave the triangle flat.
+    /// file gave them (even where the squared length over- or underflows);
+    /// normals with no direction leave the triangle flat.
     #[test]
     fn vertex_normals_are_stored_unit_length() {
         let triangle = [DVec3::ZERO, DVec3::X, DVec3::Y];
-        let lengths = [1e-150, 1e-3, 1.0, 7.5, 1e150];
+        let lengths = [1e-200, 1e-150, 1e-3, 1.0, 7.5, 1e150, 1e300];
         let mut scene = empty();
         let normals = lengths.map(|s| [DVec3::new(0.0, 0.6, 0.8) * s; 3]);
         scene.push_mesh(vec![triangle; lengths.len()], Some(normals.to_vec()), |_| 0);
@@ -415,7 +433,11 @@ mod tests {
             assert!((*n - DVec3::new(0.0, 0.6, 0.8)).length() < 1e-15, "{n}");
         }
         let mut scene = empty();
-        for bad in [DVec3::ZERO, DVec3::splat(f64::NAN), DVec3::splat(1e300)] {
+        for bad in [
+            DVec3::ZERO,
+            DVec3::splat(f64::NAN),
+            DVec3::new(1.0, f64::INFINITY, 0.0),
+        ] {
             scene.push_mesh(vec![triangle], Some(vec![[DVec3::Z, bad, DVec3::Z]]), |_| 0);
         }
         assert!(scene.vertex_normals.is_empty());
