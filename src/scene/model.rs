@@ -11,7 +11,7 @@ use crate::color::ColorConvention;
 use crate::material::{Light, Material};
 use crate::math::{Aabb, Color, DVec3};
 use crate::settings::{Protocol, RenderSettings, Sides, ViewMode};
-use crate::shapes::{Shape, Triangle};
+use crate::shapes::{Shape, Triangle, unit_or_none};
 
 use super::obj::SkippedElements;
 use super::polygon::{DroppedPolygons, triangulate};
@@ -250,7 +250,7 @@ impl Scene {
         // Stored as unit vectors: shading reads them at every hit
         // (Triangle::smooth_point needs each one unit) and normalizing
         // once here spares three square roots and divisions per hit.
-        if let Some([Some(a), Some(b), Some(c)]) = normals.map(|n| n.map(unit_normal)) {
+        if let Some([Some(a), Some(b), Some(c)]) = normals.map(|n| n.map(unit_or_none)) {
             let n = [a, b, c];
             t.vertex_normals = self.vertex_normals.len() as u32;
             Arc::make_mut(&mut self.vertex_normals).push(n);
@@ -383,24 +383,6 @@ pub(super) fn line_column(text: &str, offset: usize) -> (usize, usize) {
     let line = before.matches('\n').count() + 1;
     let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
     (line, column)
-}
-
-/// `v` as a unit vector; `None` where it has no direction (zero, or not
-/// finite). A vector whose squared length overflows or underflows (a
-/// normal 1e200 or 1e-200 long) is scaled by its largest component first,
-/// so it keeps its direction; any other is normalized as it is.
-fn unit_normal(v: DVec3) -> Option<DVec3> {
-    let largest = v.abs().max_element();
-    if !(largest > 0.0 && largest.is_finite()) {
-        return None;
-    }
-    let v = if v.length_squared().is_normal() {
-        v
-    } else {
-        v / largest
-    };
-    let n = v.normalize_or_zero();
-    (n != DVec3::ZERO).then_some(n)
 }
 
 #[cfg(test)]

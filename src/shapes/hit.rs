@@ -147,8 +147,21 @@ pub struct Surface {
     pub shading_normal: DVec3,
 }
 
-/// The unit gradient direction, or `None` where it vanishes (a cone's apex).
-pub(super) fn unit_or_none(v: DVec3) -> Option<DVec3> {
+/// `v` as a unit vector, or `None` where it has no direction (zero, or not
+/// finite): a gradient that vanishes (a cone's apex), or a vertex normal
+/// given as zero. A vector whose squared length over- or underflows (1e200
+/// or 1e-200 long) is scaled by its largest component first, so it keeps
+/// its direction.
+pub(crate) fn unit_or_none(v: DVec3) -> Option<DVec3> {
+    let length_squared = v.length_squared();
+    if length_squared.is_normal() {
+        return Some(v / length_squared.sqrt());
+    }
+    let largest = v.abs().max_element();
+    if !(largest > 0.0 && largest.is_finite()) {
+        return None;
+    }
+    let v = v / largest;
     let len = v.length();
     (len > 0.0 && len.is_finite()).then(|| v / len)
 }
@@ -156,6 +169,23 @@ pub(super) fn unit_or_none(v: DVec3) -> Option<DVec3> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn unit_or_none_keeps_the_direction_of_tiny_and_huge_vectors() {
+        let expected = DVec3::new(3.0, -4.0, 0.0) / 5.0;
+        for scale in [1e-300, 1e-200, 1e-160, 1e-3, 1.0, 1e3, 1e160, 1e200, 1e300] {
+            let n = unit_or_none(DVec3::new(3.0, -4.0, 0.0) * scale)
+                .unwrap_or_else(|| panic!("no direction at scale {scale}"));
+            assert!((n - expected).length() < 1e-15, "scale {scale}: {n}");
+        }
+        for v in [
+            DVec3::ZERO,
+            DVec3::new(f64::NAN, 1.0, 0.0),
+            DVec3::new(f64::INFINITY, 1.0, 0.0),
+        ] {
+            assert_eq!(unit_or_none(v), None, "{v}");
+        }
+    }
 
     #[test]
     fn each_permutation_is_woops_axes_and_shear() {

@@ -10,6 +10,7 @@ mod sphere;
 mod triangle;
 
 pub use cone::Cone;
+pub(crate) use hit::unit_or_none;
 pub use hit::{Crossings, PreparedRay, ShapeHit, Surface};
 pub use packet::{LaneHits, PacketHits, RayPacket};
 pub use plane::Plane;
