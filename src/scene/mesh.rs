@@ -261,19 +261,31 @@ pub(super) fn mesh_materials(
 
 /// Each scene material `mesh_materials` gave `mesh`, once, with the name a
 /// scene file uses for it: its MTL name, or `default` for faces with none
-/// or with a name no library defines.
+/// or with a name no library defines (`default (2)` and on where the MTL
+/// names a material `default` too, so each keeps its own key).
 pub(super) fn slot_names(
     mesh: &LoadedMesh,
     slots: &[u32],
     default: Option<u32>,
 ) -> Vec<(u32, String)> {
+    let taken = |name: &str| {
+        slots.iter().enumerate().any(|(slot, &index)| {
+            index != u32::MAX && Some(index) != default && mesh.material_names[slot] == name
+        })
+    };
+    let mut default_name = "default".to_owned();
+    let mut k = 2;
+    while taken(&default_name) {
+        default_name = format!("default ({k})");
+        k += 1;
+    }
     let mut names: Vec<(u32, String)> = Vec::new();
     for (slot, &index) in slots.iter().enumerate() {
         if index == u32::MAX || names.iter().any(|(i, _)| *i == index) {
             continue;
         }
         let name = if Some(index) == default {
-            "default".to_owned()
+            default_name.clone()
         } else {
             mesh.material_names[slot].clone()
         };

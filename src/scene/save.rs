@@ -634,21 +634,30 @@ mod tests {
         assert_eq!((again.image.samples, again.image.adaptive), (16, true));
     }
 
-    /// An OBJ and its MTL, from memory.
-    struct Model;
-    impl MeshSource for Model {
+    /// Files by name, from memory.
+    struct Files(&'static [(&'static str, &'static str)]);
+    impl MeshSource for Files {
         fn read(&self, path: &Path) -> std::io::Result<Vec<u8>> {
-            let text = match path.file_name().and_then(|n| n.to_str()) {
-                Some("m.obj") => {
-                    "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n\
-                     usemtl red\nf 1 2 3\nusemtl white\nf 2 4 3\nusemtl nowhere\nf 1 2 4\n"
-                }
-                Some("m.mtl") => "newmtl red\nKd 0.8 0.1 0.1\nnewmtl white\nKd 0.9 0.9 0.9\n",
-                _ => return Err(std::io::ErrorKind::NotFound.into()),
-            };
-            Ok(text.as_bytes().to_vec())
+            let name = path.file_name().and_then(|n| n.to_str());
+            match self.0.iter().find(|(file, _)| Some(*file) == name) {
+                Some((_, text)) => Ok(text.as_bytes().to_vec()),
+                None => Err(std::io::ErrorKind::NotFound.into()),
+            }
         }
     }
+
+    /// An OBJ and its MTL.
+    const MODEL: Files = Files(&[
+        (
+            "m.obj",
+            "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n\
+             usemtl red\nf 1 2 3\nusemtl white\nf 2 4 3\nusemtl nowhere\nf 1 2 4\n",
+        ),
+        (
+            "m.mtl",
+            "newmtl red\nKd 0.8 0.1 0.1\nnewmtl white\nKd 0.9 0.9 0.9\n",
+        ),
+    ]);
 
     #[test]
     fn edits_to_a_meshs_own_materials_are_written_into_its_object() {
@@ -669,7 +678,7 @@ mod tests {
                 format!("{objects}{camera}")
             };
             let path = Path::new("dir/scene.toml");
-            let loaded = load_str(&text, path, &Model).unwrap();
+            let loaded = load_str(&text, path, &MODEL).unwrap();
             let names: Vec<&str> = loaded.materials.iter().map(|m| m.name.as_str()).collect();
             assert_eq!(
                 names,
@@ -694,7 +703,7 @@ mod tests {
             };
             let saved = scene_toml(&req, path).unwrap();
             assert!(saved.left_out.is_empty(), "{saved:?}");
-            let again = load_str(&saved.text, path, &Model).unwrap_or_else(|e| {
+            let again = load_str(&saved.text, path, &MODEL).unwrap_or_else(|e| {
                 panic!("{e}\n{}", saved.text);
             });
             assert_eq!(again.materials, materials, "{}", saved.text);
@@ -716,12 +725,47 @@ mod tests {
         }
     }
 
+    /// An OBJ whose MTL names a material `default`, with faces that name
+    /// a material no library defines.
+    const DEFAULT_CLASH: Files = Files(&[
+        (
+            "m.obj",
+            "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n\
+             usemtl default\nf 1 2 3\nusemtl nowhere\nf 2 4 3\n",
+        ),
+        ("m.mtl", "newmtl default\nKd 0.8 0.1 0.1\n"),
+    ]);
+
+    #[test]
+    fn a_material_named_default_and_the_fallback_keep_apart_keys() {
+        let text = "[camera]\neye = [0, 0, 5]\nlookat = [0, 0, 0]\nup = [0, 1, 0]\nfov = 40\n\
+                    [[objects]]\nkind = \"mesh\"\npath = \"m.obj\"\n";
+        let path = Path::new("dir/scene.toml");
+        let loaded = load_str(text, path, &DEFAULT_CLASH).unwrap();
+        assert_eq!(loaded.materials.len(), 2);
+        let settings = loaded.render_settings();
+        // Each edited on its own: neither edit may reach the other.
+        for edited in 0..2 {
+            let mut materials = loaded.materials.clone();
+            materials[edited].kd = 0.125;
+            let req = SaveRequest {
+                materials: &materials,
+                ..request(&loaded, &loaded.camera, &settings)
+            };
+            let saved = scene_toml(&req, path).unwrap();
+            assert!(saved.left_out.is_empty(), "{saved:?}");
+            let again = load_str(&saved.text, path, &DEFAULT_CLASH)
+                .unwrap_or_else(|e| panic!("{e}\n{}", saved.text));
+            assert_eq!(again.materials, materials, "{}", saved.text);
+        }
+    }
+
     #[test]
     fn mesh_material_keys_are_checked() {
         let head = "[camera]\neye = [0, 0, 5]\nlookat = [0, 0, 0]\nup = [0, 1, 0]\nfov = 40\n\
                     [[objects]]\nkind = \"mesh\"\npath = \"m.obj\"\n";
         let error = |tail: &str| {
-            load_str(&format!("{head}{tail}"), Path::new("s.toml"), &Model)
+            load_str(&format!("{head}{tail}"), Path::new("s.toml"), &MODEL)
                 .unwrap_err()
                 .to_string()
         };
