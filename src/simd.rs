@@ -3,8 +3,8 @@
 //! The kernels are written once over arrays of `N` lanes (`[f64; N]`) and
 //! run inside a function compiled for the machine's best instruction set,
 //! chosen at run time through `pulp` (no `unsafe`, no `-C target-cpu`): with
-//! AVX-512 eight lanes, with AVX2 four; without either, glint traces single
-//! rays. Each lane performs the same IEEE operations in the same order as
+//! AVX2 four lanes (the default, see [`SimdChoice::choose`]), with AVX-512
+//! eight when forced; without either, glint traces single rays. Each lane performs the same IEEE operations in the same order as
 //! the single-ray code (Rust never fuses a multiply and an add by itself),
 //! so every level gives the same bytes.
 
@@ -63,20 +63,74 @@ impl SimdLevel {
             .unwrap_or(&SimdLevel::Scalar)
     }
 
-    /// The level glint uses: the best this machine runs, or a lower one
-    /// forced by the environment variable `GLINT_SIMD` (`scalar`, `avx2`
-    /// or `avx512`; a level the machine lacks falls back to the best it
-    /// has). Read once.
+    /// The level glint uses ([`SimdChoice`]). Read once.
     pub fn current() -> Self {
-        static LEVEL: OnceLock<SimdLevel> = OnceLock::new();
-        *LEVEL.get_or_init(|| {
-            let best = Self::best();
-            std::env::var("GLINT_SIMD")
-                .ok()
-                .and_then(|v| v.parse::<SimdLevel>().ok())
-                .filter(|l| l.is_available())
-                .unwrap_or(best)
-        })
+        SimdChoice::current().level
+    }
+}
+
+/// The level glint runs at, and why.
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct SimdChoice {
+    pub level: SimdLevel,
+    pub reason: String,
+}
+
+impl SimdChoice {
+    /// The default, unless the environment variable `GLINT_SIMD`
+    /// (`scalar`, `avx2` or `avx512`) forces a level this machine runs.
+    /// Read once.
+    pub fn current() -> &'static SimdChoice {
+        static CHOICE: OnceLock<SimdChoice> = OnceLock::new();
+        CHOICE.get_or_init(|| Self::choose(std::env::var("GLINT_SIMD").ok().as_deref()))
+    }
+
+    /// The level for a `GLINT_SIMD` value (`None`: unset).
+    ///
+    /// The default is AVX2 wherever the machine has it, AVX-512 or not:
+    /// the 8-lane AVX-512 build measured slower than the 4-lane AVX2 one on
+    /// every workload of the README's "SIMD levels" table (LLVM splits most
+    /// of its lane loops into 256- and 128-bit halves anyway, and the
+    /// packets' idle lanes pay the arithmetic too), so AVX-512 runs only
+    /// when forced.
+    pub fn choose(forced: Option<&str>) -> SimdChoice {
+        let default = || {
+            if SimdLevel::Avx2.is_available() {
+                let reason = if SimdLevel::Avx512.is_available() {
+                    "the default: this CPU also runs AVX-512, whose 8 lanes measured slower than \
+                     AVX2's 4 (README, \"SIMD levels\"); GLINT_SIMD=avx512 forces them"
+                } else {
+                    "the best this CPU runs (it has no AVX-512)"
+                };
+                (SimdLevel::Avx2, reason.to_string())
+            } else {
+                (
+                    SimdLevel::Scalar,
+                    "this CPU has neither AVX2 nor AVX-512: single rays".to_string(),
+                )
+            }
+        };
+        let (level, reason) = match forced.map(|v| (v, v.parse::<SimdLevel>())) {
+            None | Some(("", _)) => default(),
+            Some((v, Ok(level))) if level.is_available() => {
+                (level, format!("forced by GLINT_SIMD={v}"))
+            }
+            Some((v, Ok(_))) => {
+                let (level, reason) = default();
+                (
+                    level,
+                    format!("GLINT_SIMD={v} asks for a level this CPU lacks; {reason}"),
+                )
+            }
+            Some((v, Err(_))) => {
+                let (level, reason) = default();
+                (
+                    level,
+                    format!("GLINT_SIMD={v} is not a level (scalar, avx2, avx512); {reason}"),
+                )
+            }
+        };
+        SimdChoice { level, reason }
     }
 }
 
@@ -98,21 +152,21 @@ pub trait LaneWork {
     fn run<const N: usize>(self) -> Self::Output;
 }
 
-/// Runs `work` at `level`: with eight lanes under AVX-512, four under AVX2,
-/// and one (compiled for baseline x86-64) otherwise or where the machine
-/// lacks the level.
+/// Runs `work` at `level`: with eight lanes under AVX-512, four under
+/// AVX2. `None` at the scalar level or where the machine lacks the level:
+/// the caller then takes its single-ray path. (A one-lane instance of the
+/// packet kernel would never run, and compiling it costs as much as a
+/// SIMD one.)
 #[inline(always)]
-pub fn dispatch<W: LaneWork>(level: SimdLevel, work: W) -> W::Output {
+pub fn dispatch<W: LaneWork>(level: SimdLevel, work: W) -> Option<W::Output> {
     match level {
-        SimdLevel::Avx512 => match pulp::x86::V4::try_new() {
-            Some(simd) => pulp::Simd::vectorize(simd, Lanes(work)),
-            None => work.run::<1>(),
-        },
-        SimdLevel::Avx2 => match pulp::x86::V3::try_new() {
-            Some(simd) => pulp::Simd::vectorize(simd, Lanes(work)),
-            None => work.run::<1>(),
-        },
-        SimdLevel::Scalar => work.run::<1>(),
+        SimdLevel::Avx512 => {
+            pulp::x86::V4::try_new().and_then(|simd| pulp::Simd::vectorize(simd, Lanes(work)))
+        }
+        SimdLevel::Avx2 => {
+            pulp::x86::V3::try_new().and_then(|simd| pulp::Simd::vectorize(simd, Lanes(work)))
+        }
+        SimdLevel::Scalar => None,
     }
 }
 
@@ -122,14 +176,14 @@ pub fn dispatch<W: LaneWork>(level: SimdLevel, work: W) -> W::Output {
 struct Lanes<W>(W);
 
 impl<W: LaneWork> pulp::WithSimd for Lanes<W> {
-    type Output = W::Output;
+    type Output = Option<W::Output>;
 
     #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _simd: S) -> W::Output {
+    fn with_simd<S: pulp::Simd>(self, _simd: S) -> Option<W::Output> {
         match S::F64_LANES {
-            8 => self.0.run::<8>(),
-            4 => self.0.run::<4>(),
-            _ => self.0.run::<1>(),
+            8 => Some(self.0.run::<8>()),
+            4 => Some(self.0.run::<4>()),
+            _ => None,
         }
     }
 }
@@ -243,5 +297,38 @@ mod tests {
         assert!(SimdLevel::best().is_available());
         assert!(SimdLevel::Scalar.is_available());
         assert!(SimdLevel::current().is_available());
+    }
+
+    #[test]
+    fn avx2_is_the_default_wherever_the_machine_has_it() {
+        let default = SimdChoice::choose(None);
+        let expected = if SimdLevel::Avx2.is_available() {
+            SimdLevel::Avx2
+        } else {
+            SimdLevel::Scalar
+        };
+        assert_eq!(default.level, expected);
+        assert_eq!(SimdChoice::choose(Some("")), default);
+        // A forced level the machine runs is taken; scalar always is.
+        let scalar = SimdChoice::choose(Some("scalar"));
+        assert_eq!(scalar.level, SimdLevel::Scalar);
+        assert!(
+            scalar.reason.contains("GLINT_SIMD=scalar"),
+            "{}",
+            scalar.reason
+        );
+        for level in SimdLevel::ALL {
+            let forced = SimdChoice::choose(Some(level.name()));
+            if level.is_available() {
+                assert_eq!(forced.level, level);
+            } else {
+                assert_eq!(forced.level, default.level);
+                assert!(forced.reason.contains("lacks"), "{}", forced.reason);
+            }
+        }
+        // Nonsense falls back to the default and says so.
+        let bad = SimdChoice::choose(Some("avx9"));
+        assert_eq!(bad.level, default.level);
+        assert!(bad.reason.contains("not a level"), "{}", bad.reason);
     }
 }

@@ -26,7 +26,9 @@ impl Renderer<'_> {
                 tile,
                 count_work,
             };
-            return crate::simd::dispatch(self.simd, packets);
+            if let Some(out) = crate::simd::dispatch(self.simd, packets) {
+                return out;
+            }
         }
         let mut out = TileOutput {
             values: Vec::with_capacity(tile.pixels()),

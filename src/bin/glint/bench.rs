@@ -106,6 +106,8 @@ struct SceneBench {
     samples: u32,
     max_depth: u32,
     threads: usize,
+    /// The SIMD level the packets ran at (`glint info --simd` says why).
+    simd: glint::simd::SimdLevel,
     repeats: u32,
     load_s: f64,
     build_s: f64,
@@ -265,6 +267,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             samples: settings.samples,
             max_depth: settings.max_depth,
             threads,
+            simd: glint::simd::SimdLevel::current(),
             repeats: args.repeat,
             load_s,
             build_s: median(build_times),

@@ -1,4 +1,5 @@
-//! `glint info`: how a PNG that glint wrote was made.
+//! `glint info`: how a PNG that glint wrote was made; `--simd`: which
+//! instruction set this machine renders with, and why.
 
 use std::path::PathBuf;
 
@@ -9,7 +10,12 @@ use anyhow::Result;
 #[derive(clap::Args)]
 pub struct InfoArgs {
     /// A PNG written by glint (`glint render` or the viewer's export).
-    pub png: PathBuf,
+    #[arg(required_unless_present = "simd")]
+    pub png: Option<PathBuf>,
+    /// Say which SIMD level this machine renders with and why (the levels
+    /// it runs, and whether `GLINT_SIMD` forced one), instead of reading a PNG.
+    #[arg(long, conflicts_with_all = ["png", "scene_text"])]
+    pub simd: bool,
     /// Print the record as one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
@@ -19,18 +25,57 @@ pub struct InfoArgs {
 }
 
 pub fn run(args: &InfoArgs) -> Result<()> {
-    let record = glint::export::read_record(&args.png)?;
     let mut out = std::io::stdout().lock();
-    match write_info(&mut out, args, &record) {
+    let written = match &args.png {
+        Some(png) if !args.simd => {
+            let record = glint::export::read_record(png)?;
+            write_info(&mut out, args, png, &record)
+        }
+        _ => write_simd(&mut out, args.json),
+    };
+    match written {
         // A closed pipe (`glint info F | head`) is the reader's choice.
         Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
         other => Ok(other?),
     }
 }
 
+fn write_simd(out: &mut impl Write, json: bool) -> std::io::Result<()> {
+    use glint::simd::{SimdChoice, SimdLevel};
+    let choice = SimdChoice::current();
+    let available: Vec<&str> = SimdLevel::ALL
+        .into_iter()
+        .filter(|l| l.is_available())
+        .map(SimdLevel::name)
+        .collect();
+    if json {
+        let value = serde_json::json!({
+            "level": choice.level,
+            "lanes": choice.level.lanes(),
+            "reason": choice.reason,
+            "available": available,
+        });
+        return writeln!(out, "{}", serde_json::to_string_pretty(&value)?);
+    }
+    writeln!(
+        out,
+        "simd       {} ({} lane{}): {}",
+        choice.level.name(),
+        choice.level.lanes(),
+        if choice.level.lanes() == 1 { "" } else { "s" },
+        choice.reason
+    )?;
+    writeln!(out, "available  {}", available.join(", "))?;
+    writeln!(
+        out,
+        "           every level gives the same image bytes; GLINT_SIMD=scalar|avx2|avx512 forces one"
+    )
+}
+
 fn write_info(
     out: &mut impl Write,
     args: &InfoArgs,
+    png: &std::path::Path,
     record: &glint::export::RenderRecord,
 ) -> std::io::Result<()> {
     if args.json {
@@ -46,7 +91,7 @@ fn write_info(
     let s = &record.settings;
     let r = &s.render;
     let v3 = |v: [f64; 3]| format!("{} {} {}", v[0], v[1], v[2]);
-    writeln!(out, "file          {}", args.png.display())?;
+    writeln!(out, "file          {}", png.display())?;
     writeln!(out, "glint         {}", record.glint_version)?;
     writeln!(out, "scene         {}", record.scene_path)?;
     writeln!(out, "scene sha256  {}", record.scene_sha256)?;
@@ -130,7 +175,7 @@ fn write_info(
     writeln!(
         out,
         "re-render     glint render --from-png {} -o NEW.png",
-        args.png.display()
+        png.display()
     )?;
     if args.scene_text {
         writeln!(out, "---")?;
