@@ -148,6 +148,7 @@ fn job(
         camera: scene.camera,
         settings,
         preview: None,
+        serial: 0,
     };
     (job, scene, octree)
 }
@@ -209,6 +210,73 @@ fn each_plan_shows_its_passes_and_ends_on_the_cli_frame() {
             "{scene_file}: the finished buffer equals the CLI render"
         );
     }
+}
+
+/// While the user drags, previews asked for while one is in flight do not
+/// cancel it: it completes and is shown, the newest one waits (replacing
+/// the older waiting one) and runs next; a full job cancels both.
+#[test]
+fn previews_in_flight_complete_and_the_newest_waiting_one_follows() {
+    use glint::viewer::worker::{Preview, Reflections};
+    let worker = Worker::spawn(2, || {});
+    let preview = Preview {
+        divisor: 1,
+        reflections: Reflections::All,
+        shadows: true,
+    };
+    // A preview that takes a while: the glass scene at 640x480.
+    let (mut slow, _, _) = job("scenes/glass.toml", 640, 480, AntiAliasing::Off);
+    slow.preview = Some(preview);
+    slow.serial = 1;
+    worker.submit_preview(slow.clone());
+    let first = worker.generation();
+    let start = std::time::Instant::now();
+    while worker.tiles_started(first) == 0 {
+        assert!(start.elapsed() < WAIT);
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    // Two newer cameras while it renders: the second replaces the first.
+    for serial in [2, 3] {
+        let mut newer = slow.clone();
+        newer.camera.eye.x += 0.1 * serial as f64;
+        newer.serial = serial;
+        worker.submit_preview(newer);
+    }
+    assert_eq!(worker.generation(), first, "nothing was cancelled");
+    let start = std::time::Instant::now();
+    while worker.with_buffer(|b| b.serial) != 3 || worker.preview_counts().completed < 2 {
+        assert!(start.elapsed() < WAIT, "{:?}", worker.preview_counts());
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    let counts = worker.preview_counts();
+    assert_eq!(
+        (counts.started, counts.completed),
+        (2, 2),
+        "the preview in flight and the newest waiting one ran, both to the end"
+    );
+    assert!(worker.with_buffer(|b| b.finished && b.width == 640));
+
+    // A preview in flight with one waiting, then a full job: both go.
+    // (A new worker: the first may not yet have emptied its queue.)
+    let worker = Worker::spawn(2, || {});
+    slow.serial = 4;
+    worker.submit_preview(slow.clone());
+    let in_flight = worker.generation();
+    while worker.tiles_started(in_flight) == 0 {
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    slow.serial = 5;
+    worker.submit_preview(slow.clone());
+    let (mut full, _, _) = job("scenes/sphere.toml", 32, 24, AntiAliasing::Off);
+    full.serial = 6;
+    let g = worker.submit(full);
+    assert!(worker.wait_finished(g, WAIT));
+    assert_eq!(worker.with_buffer(|b| b.serial), 6);
+    std::thread::sleep(Duration::from_millis(50));
+    let counts = worker.preview_counts();
+    assert_eq!(counts.started, 1, "the waiting preview never started");
+    assert_eq!(counts.completed, 0, "the one in flight was cancelled");
+    assert_eq!(worker.generation(), g);
 }
 
 #[test]
@@ -373,6 +441,63 @@ fn pin_as_a_then_octree_off_reads_zero_pixels_differ() {
         stats.differing > 0 && stats.differing < stats.total / 2,
         "AA changes edge pixels only: {stats:?}"
     );
+}
+
+/// Dragging sends every frame's camera to the worker, yet cancels no
+/// preview: each generation the drag uses is a preview that started (a
+/// preview asked for while one renders waits instead of bumping it), and
+/// once the drag holds still the image on screen is the preview of the
+/// newest camera.
+#[test]
+fn a_drag_cancels_no_preview_and_ends_on_the_newest_camera() {
+    let mut h = harness(app_for("scenes/glass.toml", 320, 240));
+    settle(&mut h);
+    let generation_before = h.state().worker().generation();
+    let before = h.state().worker().preview_counts();
+    let camera = *h.state().camera();
+    let start = h.state().image_rect().unwrap().center();
+    h.hover_at(start);
+    h.run_steps(1);
+    h.drag_at(start);
+    h.run_steps(1);
+    for k in 1..=20 {
+        h.hover_at(start + egui::vec2(3.0 * k as f32, 0.0));
+        h.run_steps(1);
+    }
+    assert_ne!(*h.state().camera(), camera, "the drag orbits");
+    // The button is still down: wait until the last camera's preview is
+    // on screen.
+    let waited = std::time::Instant::now();
+    while h.state().worker().with_buffer(|b| b.serial) != h.state().input_serial() {
+        assert!(
+            waited.elapsed() < WAIT,
+            "the newest camera's preview never showed"
+        );
+        std::thread::sleep(Duration::from_millis(2));
+        h.run_steps(1);
+    }
+    let counts = h.state().worker().preview_counts();
+    let started = counts.started - before.started;
+    assert!(started >= 2, "{counts:?}");
+    assert_eq!(
+        counts.completed - before.completed,
+        started,
+        "every preview started was completed"
+    );
+    assert_eq!(
+        h.state().worker().generation() - generation_before,
+        started,
+        "no generation went to a preview that never started"
+    );
+    assert!(
+        h.state()
+            .worker()
+            .with_buffer(|b| matches!(b.pass, Some(PassKind::Preview(_))) && b.finished)
+    );
+    h.drop_at(start + egui::vec2(60.0, 0.0));
+    h.run_steps(1);
+    settle(&mut h);
+    assert!(h.state().final_pass_shown());
 }
 
 #[test]

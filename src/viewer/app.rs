@@ -12,6 +12,7 @@ use super::command::Command;
 use super::compare::{Compare, CompareMode, DiffStats};
 use super::inspect::InspectState;
 use super::octree_panel::{OctreeInfo, SuggestionJob, last_full_pass};
+use super::orbit_bench::{OrbitBench, OrbitBenchOptions, ShownFrame};
 use super::panels::{Message, RenderInfo};
 use super::pixel::Inspection;
 use super::pixel::WalkTarget;
@@ -58,6 +59,9 @@ pub struct ViewerOptions {
     pub compare: Option<CompareSetting>,
     /// Show the comparison as a difference rather than a split.
     pub compare_difference: bool,
+    /// Orbit the scene with synthetic pointer events once its first image
+    /// is complete, print the benchmark's report on stdout, then exit.
+    pub orbit_bench: Option<OrbitBenchOptions>,
 }
 
 /// Everything that decides the rendered image; a change restarts the passes.
@@ -117,6 +121,9 @@ pub struct GlintApp {
     screenshot: Option<Screenshot>,
     /// Where the image was drawn in the last frame (screen points).
     image_rect: Option<egui::Rect>,
+    /// Pointer events so far: each job carries the count it reflects.
+    input_serial: u64,
+    orbit_bench: Option<OrbitBench>,
 }
 
 impl GlintApp {
@@ -174,6 +181,8 @@ impl GlintApp {
                 .screenshot
                 .map(|path| Screenshot::new(path, options.frames)),
             image_rect: None,
+            input_serial: 0,
+            orbit_bench: options.orbit_bench.map(OrbitBench::new),
         };
         if let Some((i, j)) = options.inspect {
             app.inspect_pixel(i, j);
@@ -300,6 +309,12 @@ impl GlintApp {
     /// One frame of the viewer: drawn into `ui`, which covers the window.
     pub fn frame_ui(&mut self, ui: &mut egui::Ui) {
         let ctx = ui.ctx().clone();
+        self.input_serial += ctx.input(|i| {
+            i.events
+                .iter()
+                .filter(|e| super::orbit_bench::is_pointer(e))
+                .count() as u64
+        });
         if let Some(failure) = self.worker.take_failure() {
             self.say(failure, true);
         }
@@ -315,6 +330,7 @@ impl GlintApp {
             && ctx.input(|i| i.viewport().close_requested())
             && self.unsaved()
             && self.screenshot.is_none()
+            && self.orbit_bench.is_none()
         {
             ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
             self.discarding = Some(Discarding::Quit);
@@ -379,6 +395,60 @@ impl GlintApp {
         self.compare_logic();
         self.sync_render();
         self.screenshot_logic(&ctx);
+        self.orbit_bench_logic(&ctx);
+    }
+
+    /// Before a frame: the orbit benchmark's events go into its input.
+    pub fn raw_input_logic(&mut self, raw: &mut egui::RawInput) {
+        if self.orbit_bench.is_some() {
+            let ready = self.compare_pending.is_none() && self.final_pass_shown();
+            let state = (
+                self.input_serial,
+                self.worker.generation(),
+                self.worker.preview_counts(),
+            );
+            if let Some(bench) = &mut self.orbit_bench {
+                bench.inject(raw, self.image_rect, ready, state);
+            }
+        }
+    }
+
+    /// Pointer events so far; a job submitted now carries this number.
+    pub fn input_serial(&self) -> u64 {
+        self.input_serial
+    }
+
+    /// After a frame: the orbit benchmark's report once the final pass after
+    /// its drag is on screen, and the window closes.
+    fn orbit_bench_logic(&mut self, ctx: &egui::Context) {
+        if let Some(bench) = &mut self.orbit_bench {
+            bench.request_wake(ctx);
+        }
+        if self.orbit_bench.as_ref().is_none_or(OrbitBench::is_done) {
+            return;
+        }
+        let final_shown = self
+            .final_pass_shown()
+            .then(|| self.worker.with_buffer(|b| b.serial));
+        let (w, h) = (self.edit.settings.width, self.edit.settings.height);
+        let describe = serde_json::json!({
+            "scene": self.edit.source.display_name(),
+            "image": [w, h],
+            "window": [ctx.content_rect().width(), ctx.content_rect().height()],
+            "threads": self.worker.threads(),
+            "simd": crate::simd::SimdLevel::current().name(),
+            "final_pass": self.edit.settings.anti_aliasing().name(),
+        });
+        let history = self.worker.history();
+        let counts = self.worker.preview_counts();
+        if let Some(report) = self
+            .orbit_bench
+            .as_mut()
+            .and_then(|bench| bench.finish(final_shown, &history, counts, describe))
+        {
+            println!("{report}");
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        }
     }
 
     /// The image, and mouse control of the camera over it.
@@ -509,13 +579,21 @@ impl GlintApp {
         if self.submitted.as_ref() == Some(&inputs) {
             return;
         }
-        self.worker.submit(Job {
+        let job = Job {
             scene: Arc::clone(&edit.scene),
             octree: Arc::clone(&self.octree),
             camera: edit.camera,
             settings: edit.settings,
             preview: inputs.preview,
-        });
+            serial: self.input_serial,
+        };
+        // While dragging, the preview in flight is finished and shown; this
+        // camera waits for it (or for the next, newer one).
+        if job.preview.is_some() {
+            self.worker.submit_preview(job);
+        } else {
+            self.worker.submit(job);
+        }
         self.submitted = Some(inputs);
         // The inspected pixel follows the change: its rays are traced again
         // (one pixel, a few microseconds) so the panel never shows a stale tree.
@@ -535,10 +613,19 @@ impl GlintApp {
                         [b.width as usize, b.height as usize],
                         &b.rgba,
                     ),
+                    ShownFrame {
+                        generation: b.generation,
+                        serial: b.serial,
+                        pass: b.pass,
+                        finished: b.finished,
+                    },
                 )
             })
         });
-        if let Some(Some((version, image))) = update {
+        if let Some(Some((version, image, frame))) = update {
+            if let Some(bench) = &mut self.orbit_bench {
+                bench.shown(frame);
+            }
             self.shown_version = version;
             match &mut self.texture {
                 Some(t) => t.set(image, TEXTURE),
@@ -896,6 +983,10 @@ impl GlintApp {
 impl eframe::App for GlintApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         self.frame_ui(ui);
+    }
+
+    fn raw_input_hook(&mut self, _ctx: &egui::Context, raw_input: &mut egui::RawInput) {
+        self.raw_input_logic(raw_input);
     }
 }
 

@@ -10,7 +10,8 @@ use crate::settings::RenderSettings;
 /// keep their look), then without reflections, then without shadows too. Estimates come
 /// from this scene's last full 1-sample pass (its time per pixel, and
 /// its rays by kind for what dropping reflections or shadows saves),
-/// corrected by how far the last preview's estimate was off.
+/// made more careful when the last preview took longer than estimated; a
+/// candidate already tried is judged by its own measured times.
 pub fn choose_preview(
     history: &[PassRecord],
     settings: &RenderSettings,
@@ -29,17 +30,38 @@ pub fn choose_preview(
         return Some((fallback, f64::NAN));
     };
     let estimate = |p: &Preview| estimate_preview(base, p, settings);
-    // How far off the model was on the last preview it predicted.
+    // How far off the model was on the last preview it predicted: slower
+    // than estimated makes every estimate more careful. Faster than
+    // estimated makes none bolder: the model prices every ray alike, while
+    // an eye ray in a packet costs a fraction of a single reflected ray
+    // and its shadow rays, so a correction learnt on a preview without
+    // reflections would send a drag into one with them at several times
+    // the budget.
     let correction = history
         .iter()
         .rev()
         .find_map(|r| match r.kind {
             PassKind::Preview(p) if r.finished_at > base.finished_at => {
-                Some((r.seconds / estimate(&p)).clamp(0.25, 4.0))
+                Some((r.seconds / estimate(&p)).clamp(1.0, 4.0))
             }
             _ => None,
         })
         .unwrap_or(1.0);
+    // A candidate measured since the base pass is judged by its own
+    // recent times (the median of its last three), the model only guides
+    // the choice of candidates not yet tried: a fixed cost per preview
+    // makes the model's pixel scaling too hopeful for large previews.
+    let measured = |p: &Preview| {
+        let mut times: Vec<f64> = history
+            .iter()
+            .rev()
+            .filter(|r| r.kind == PassKind::Preview(*p) && r.finished_at > base.finished_at)
+            .take(3)
+            .map(|r| r.seconds)
+            .collect();
+        times.sort_by(f64::total_cmp);
+        times.get(times.len() / 2).copied()
+    };
     let budget = budget_ms / 1000.0;
     let candidates = [1u32, 2, 4, 8].into_iter().flat_map(|divisor| {
         [
@@ -56,7 +78,7 @@ pub fn choose_preview(
     });
     let mut last = None;
     for p in candidates {
-        let t = estimate(&p) * correction;
+        let t = measured(&p).unwrap_or_else(|| estimate(&p) * correction);
         if t <= budget {
             return Some((p, t));
         }
@@ -207,6 +229,41 @@ mod tests {
             (estimate - 4.0 * 0.4 / 16.0 * 100.0 / 380.0).abs() < 1e-12,
             "{estimate}"
         );
+    }
+
+    #[test]
+    fn a_preview_measured_over_budget_is_not_chosen_again() {
+        // The full 1-sample pass took 400 ms, so the model puts 1/2 at
+        // 100 ms, within 104 ms; measured at 150 ms it is left out, and
+        // 1/2 with one bounce (89 ms) is next.
+        let p = |divisor, reflections| Preview {
+            divisor,
+            reflections,
+            shadows: true,
+        };
+        let at = |kind, seconds, finished_at| PassRecord {
+            kind: PassKind::Preview(kind),
+            seconds,
+            finished_at,
+            ..base()
+        };
+        // The latest preview as fast as estimated: no correction.
+        let history = [
+            base(),
+            at(p(2, Reflections::All), 0.15, 2.0),
+            at(p(4, Reflections::All), 0.025, 3.0),
+        ];
+        let (chosen, estimate) = choose_preview(&history, &settings(), 104.0).unwrap();
+        assert_eq!(chosen, p(2, Reflections::OneBounce));
+        assert!((estimate - 0.1 * 340.0 / 380.0).abs() < 1e-12, "{estimate}");
+        let unmeasured = [base(), history[2]];
+        let (chosen, _) = choose_preview(&unmeasured, &settings(), 104.0).unwrap();
+        assert_eq!(chosen, p(2, Reflections::All));
+        // A preview faster than estimated makes no other estimate bolder.
+        let fast = [base(), at(p(4, Reflections::All), 0.005, 3.0)];
+        let (chosen, estimate) = choose_preview(&fast, &settings(), 104.0).unwrap();
+        assert_eq!(chosen, p(2, Reflections::All));
+        assert!((estimate - 0.1).abs() < 1e-12, "{estimate}");
     }
 
     #[test]

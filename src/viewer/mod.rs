@@ -13,6 +13,7 @@ mod input;
 pub mod inspect;
 mod octree_panel;
 mod orbit;
+pub mod orbit_bench;
 mod panels;
 pub mod pixel;
 mod save;

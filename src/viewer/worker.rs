@@ -5,6 +5,12 @@
 //! The UI never waits on it: it publishes a job and bumps the generation
 //! counter; tiles of an older generation are dropped. The buffer's lock is
 //! held only to copy one finished tile in or the display image out.
+//!
+//! Previews while the user drags are the exception: a preview in flight
+//! runs to completion and is shown, and the newest camera waits (one job,
+//! replaced by each newer one) until it is; then it starts at once. A
+//! preview cancelled by every pointer event is never seen when events come
+//! faster than previews finish.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{Receiver, Sender, channel};
@@ -32,6 +38,10 @@ pub struct Job {
     /// 1/`divisor` of the resolution and as simplified as the frame budget
     /// chose; `None`: the full progressive sequence.
     pub preview: Option<Preview>,
+    /// The caller's number for the input this job reflects (the viewer
+    /// counts pointer events), carried to the display buffer so the UI
+    /// can tell how new a shown frame is.
+    pub serial: u64,
 }
 
 /// Which pass produced a buffer.
@@ -163,6 +173,8 @@ pub struct DisplayBuffer {
     /// What the pass on screen renders: scene, camera and settings (its
     /// size, samples and the view its frame holds), for export records.
     pub source: Option<FrameSource>,
+    /// The [`Job::serial`] of the job on screen.
+    pub serial: u64,
 }
 
 /// The inputs of a pass, exactly as rendered.
@@ -196,6 +208,28 @@ struct Shared {
     failure: Mutex<Option<String>>,
     /// Recent finished passes, shown again without rendering.
     cache: Mutex<PassCache>,
+    /// The preview in flight and the one waiting for it.
+    previews: Mutex<PreviewQueue>,
+    previews_started: AtomicU64,
+    previews_completed: AtomicU64,
+}
+
+/// While the user drags: the generation of the preview in flight (sent or
+/// rendering), and the newest preview asked for since, which starts when
+/// that one is done.
+#[derive(Default)]
+struct PreviewQueue {
+    in_flight: Option<u64>,
+    waiting: Option<Job>,
+}
+
+/// How the previews of a worker's life went (the orbit benchmark's counts).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PreviewCounts {
+    /// Previews the worker began rendering.
+    pub started: u64,
+    /// Previews that finished and went into the display buffer.
+    pub completed: u64,
 }
 
 /// What decides a pass: the scene (by identity: an edit makes a new one),
@@ -350,6 +384,9 @@ impl Worker {
             last_repaint: Mutex::new(Instant::now()),
             failure: Mutex::new(None),
             cache: Mutex::new(PassCache::default()),
+            previews: Mutex::new(PreviewQueue::default()),
+            previews_started: AtomicU64::new(0),
+            previews_completed: AtomicU64::new(0),
         });
         let (tx, rx) = channel();
         let thread_shared = Arc::clone(&shared);
@@ -381,9 +418,45 @@ impl Worker {
         self.threads
     }
 
-    /// Starts rendering `job`, abandoning whatever was in flight. Returns
-    /// the job's generation.
+    /// Starts rendering `job`, abandoning whatever was in flight (a
+    /// preview too, and the one waiting for it). Returns the job's
+    /// generation.
     pub fn submit(&self, job: Job) -> u64 {
+        let mut previews = self.previews();
+        *previews = PreviewQueue::default();
+        self.send(job)
+    }
+
+    /// Renders the preview `job` (a job with [`Job::preview`]) without
+    /// cancelling a preview in flight: if one is, `job` waits, replacing
+    /// any job waiting before it, and starts as soon as the one in flight
+    /// is in the display buffer. Latest wins, after completion.
+    pub fn submit_preview(&self, job: Job) {
+        debug_assert!(job.preview.is_some());
+        let mut previews = self.previews();
+        if previews.in_flight.is_some() {
+            previews.waiting = Some(job);
+        } else {
+            previews.in_flight = Some(self.send(job));
+        }
+    }
+
+    /// How many previews were started and completed so far.
+    pub fn preview_counts(&self) -> PreviewCounts {
+        PreviewCounts {
+            started: self.shared.previews_started.load(Ordering::SeqCst),
+            completed: self.shared.previews_completed.load(Ordering::SeqCst),
+        }
+    }
+
+    fn previews(&self) -> std::sync::MutexGuard<'_, PreviewQueue> {
+        self.shared
+            .previews
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+    }
+
+    fn send(&self, job: Job) -> u64 {
         let generation = self.shared.generation.fetch_add(1, Ordering::SeqCst) + 1;
         if let Some(tx) = &self.jobs {
             let _ = tx.send((generation, job));
@@ -398,6 +471,7 @@ impl Worker {
     /// Stops the passes in flight (within a tile per thread), keeping the
     /// image as far as it got; the next submitted job renders as usual.
     pub fn stop(&self) {
+        *self.previews() = PreviewQueue::default();
         let mut b = self.shared.buffer.lock().unwrap_or_else(|e| e.into_inner());
         if b.finished {
             return;
@@ -465,7 +539,9 @@ impl Worker {
 
 impl Drop for Worker {
     fn drop(&mut self) {
-        // Cancel the work in flight, close the channel, then join.
+        // Cancel the work in flight (and the preview waiting for it),
+        // close the channel, then join.
+        *self.previews() = PreviewQueue::default();
         self.shared.generation.fetch_add(1, Ordering::SeqCst);
         self.jobs.take();
         if let Some(t) = self.thread.take() {
@@ -491,11 +567,30 @@ fn run(shared: Arc<Shared>, rx: Receiver<(u64, Job)>, threads: usize) {
         while let Ok(newer) = rx.try_recv() {
             next = newer;
         }
-        let (generation, job) = next;
-        if shared.generation.load(Ordering::SeqCst) != generation {
-            continue;
+        let (mut generation, mut job) = next;
+        while shared.generation.load(Ordering::SeqCst) == generation {
+            pool.install(|| render_job(&shared, generation, &job));
+            if job.preview.is_none() {
+                break;
+            }
+            // The preview is on screen (or was cancelled by a full job,
+            // which emptied the queue): the camera that waited starts now.
+            let mut previews = shared.previews.lock().unwrap_or_else(|e| e.into_inner());
+            if previews.in_flight != Some(generation) {
+                break;
+            }
+            match previews.waiting.take() {
+                Some(waiting) => {
+                    generation = shared.generation.fetch_add(1, Ordering::SeqCst) + 1;
+                    previews.in_flight = Some(generation);
+                    job = waiting;
+                }
+                None => {
+                    previews.in_flight = None;
+                    break;
+                }
+            }
         }
-        pool.install(|| render_job(&shared, generation, &job));
     }
 }
 
@@ -521,6 +616,9 @@ fn render_job(shared: &Shared, generation: u64, job: &Job) {
     };
     if job.preview.is_none() && show_cached(shared, generation, job, &renderer.plan(true)) {
         return;
+    }
+    if job.preview.is_some() {
+        shared.previews_started.fetch_add(1, Ordering::SeqCst);
     }
     let watch = Display {
         shared,
@@ -613,6 +711,7 @@ fn show_cached(
             camera: job.camera,
             settings,
         });
+        b.serial = job.serial;
         b.last_frame = Some(frame);
         b.version += 1;
     }
@@ -673,21 +772,24 @@ impl PassWatch for Display<'_> {
 
     fn pass_started(&self, pass: &PassInfo) {
         self.done.store(0, Ordering::Relaxed);
+        if self.job.preview.is_some() {
+            // The buffer goes on describing the preview on screen until
+            // this one is complete: the UI counts what it shows by it.
+            return;
+        }
         let (w, h) = (pass.width, pass.height);
-        let preview = self.job.preview.is_some();
         let mut b = self.buffer();
         // A full pass sweeps in over the previous image, first scaled to
         // the new size if it differs (after a preview).
-        if !preview && (b.width != w || b.height != h || b.rgba.len() != (w * h * 4) as usize) {
+        if b.width != w || b.height != h || b.rgba.len() != (w * h * 4) as usize {
             b.rgba = resample_rgba(&b.rgba, b.width, b.height, w, h);
             b.width = w;
             b.height = h;
         }
         b.generation = self.generation;
-        b.pass = Some(PassKind::of(pass.kind, self.job.preview));
-        if !preview {
-            b.source = Some(self.source(pass, pass.view));
-        }
+        b.serial = self.job.serial;
+        b.pass = Some(PassKind::of(pass.kind, None));
+        b.source = Some(self.source(pass, pass.view));
         b.tiles_done = 0;
         b.tiles_total = pass.tiles;
         b.finished = false;
@@ -752,12 +854,22 @@ impl PassWatch for Display<'_> {
         let rgba = rgb_to_rgba(&frame.to_rgb8());
         {
             let mut b = self.buffer();
-            if b.generation != self.generation {
+            // Checked under the lock: a newer job's first write waits for it.
+            if self.stale() {
                 return;
             }
+            b.generation = self.generation;
+            b.pass = Some(PassKind::of(pass.info.kind, self.job.preview));
+            b.stopped = false;
             b.rgba = rgba;
             b.width = frame.width;
             b.height = frame.height;
+            b.serial = self.job.serial;
+            if self.job.preview.is_some() {
+                self.shared
+                    .previews_completed
+                    .fetch_add(1, Ordering::SeqCst);
+            }
             b.source = Some(self.source(&pass.info, frame.view));
             b.finished = pass.info.is_last();
             b.last_frame = Some(frame.clone());

@@ -60,6 +60,15 @@ pub struct ViewArgs {
     /// Show the comparison as |A - B| instead of a split.
     #[arg(long)]
     pub compare_difference: bool,
+    /// Benchmark orbiting: once the first image is complete, drag the
+    /// camera round for SECONDS with synthetic pointer events, then print
+    /// one JSON object (previews shown, latency, the final pass's time)
+    /// on stdout and exit.
+    #[arg(long, value_name = "SECONDS", value_parser = bench_seconds, conflicts_with_all = ["screenshot", "compare"])]
+    pub orbit_bench: Option<f64>,
+    /// With --orbit-bench: pointer events per second (a mouse sends 60 to 125).
+    #[arg(long, value_name = "HZ", default_value_t = 60.0, requires = "orbit_bench", value_parser = event_hz)]
+    pub event_hz: f64,
     #[command(flatten)]
     pub rules: RulesArgs,
 }
@@ -89,6 +98,8 @@ impl Default for ViewArgs {
             walk_step: None,
             compare: None,
             compare_difference: false,
+            orbit_bench: None,
+            event_hz: 60.0,
             rules: RulesArgs::default(),
         }
     }
@@ -153,6 +164,12 @@ pub fn run(args: &ViewArgs) -> Result<()> {
             CompareArg::Aa => CompareSetting::AntiAliasing,
         }),
         compare_difference: args.compare_difference,
+        orbit_bench: args.orbit_bench.map(|seconds| {
+            glint::viewer::orbit_bench::OrbitBenchOptions {
+                seconds,
+                event_hz: args.event_hz,
+            }
+        }),
     };
     // Without a display winit fails with its own source path in the
     // message: say what is missing and what works headless instead.
@@ -181,6 +198,26 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         }),
     )
     .map_err(|e| anyhow!("the viewer window failed: {e}"))
+}
+
+/// `--orbit-bench`'s drag: more than nothing, at most ten minutes.
+fn bench_seconds(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(s) if s > 0.0 && s <= 600.0 => Ok(s),
+        _ => Err(format!(
+            "{text:?}: give the drag's length in seconds, above 0 and at most 600"
+        )),
+    }
+}
+
+/// `--event-hz`: from one to a thousand events a second.
+fn event_hz(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(hz) if (1.0..=1000.0).contains(&hz) => Ok(hz),
+        _ => Err(format!(
+            "{text:?}: give pointer events per second, from 1 to 1000"
+        )),
+    }
 }
 
 /// `eye[/K...][/shadow/L]` as a walk target.
