@@ -125,7 +125,17 @@ fn timing_grid_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
                 let sixteen = of_shown(PassKind::SixteenSamples);
                 row("1-sample pass", one.map_or(pending.into(), pass_time));
                 if edit.settings.samples > 1 || sixteen.is_some() {
-                    row("16-sample pass", sixteen.map_or(pending.into(), pass_time));
+                    // Which 16-sample pass ran: the two differ in time
+                    // far more than in the picture (README, "Adaptive
+                    // anti-aliasing").
+                    let adaptive =
+                        sixteen.map_or(edit.settings.adaptive, |r| r.refined_pixels.is_some());
+                    let label = if adaptive {
+                        "16-sample pass (adaptive)"
+                    } else {
+                        "16-sample pass (full 4x4 grid)"
+                    };
+                    row(label, sixteen.map_or(pending.into(), pass_time));
                 }
                 if let Some(r) = sixteen
                     && let Some(refined) = r.refined_pixels
