@@ -8,7 +8,7 @@ use egui::{Color32, DragValue, RichText};
 use super::command::Command;
 use super::inspect::InspectState;
 use super::state::EditState;
-use super::worker::{Preview, Worker};
+use super::worker::{PassKind, Preview, Worker};
 use crate::accel::Octree;
 use crate::color::ColorConvention;
 use crate::math::DVec3;
@@ -386,7 +386,15 @@ pub fn status_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) -> Vec<
                 ));
             }
             Some((Some(pass), done, total, finished, elapsed, false)) => {
-                if finished {
+                if let PassKind::Preview(p) = pass {
+                    // A drag's frames: the full passes follow on release.
+                    ui.label(format!(
+                        "moving: preview {} ({}x{}); the full image follows when you let go",
+                        p.describe(),
+                        (edit.settings.width / p.divisor).max(1),
+                        (edit.settings.height / p.divisor).max(1)
+                    ));
+                } else if finished {
                     ui.label(format!(
                         "done: {} ({}x{})",
                         pass.label(),
