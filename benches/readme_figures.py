@@ -368,6 +368,87 @@ def prediction():
     return f"{tables}\n\n{made}"
 
 
+SIMD_WORKLOADS = [
+    ("bunny primary rays, normals view, 1024x768",
+     ["scenes/bunny.toml", "--view", "normals", "--samples", "1", "--size", "1024x768"]),
+    ("bunny on floor, 16 spp, 512x384", ["benches/peers/bunny_floor.toml", "--size", "512x384"]),
+    ("`scenes/default.toml`, 1 spp, 800x600", ["scenes/default.toml", "--samples", "1"]),
+    ("`scenes/default.toml`, adaptive 16 spp, 800x600", ["scenes/default.toml", "--aa", "adaptive"]),
+    ("viewer preview \"1/2, no reflections\": default at 400x300, depth 1",
+     ["scenes/default.toml", "--samples", "1", "--size", "400x300", "--max-depth", "1"]),
+    ("SPD gears, 1 spp, 512x512", ["scenes/spd/gears.nff", "--size", "512x512", "--samples", "1"]),
+    ("SPD rings, 1 spp, 512x512", ["scenes/spd/rings.nff", "--size", "512x512", "--samples", "1"]),
+]
+
+
+def simd():
+    """Scalar, AVX2 and AVX-512 on the README's workloads, interleaved."""
+    levels = [l for l in ("scalar", "avx2", "avx512")
+              if json.loads(glint("info", "--simd", "--json"))["available"].count(l)]
+    default = json.loads(glint("info", "--simd", "--json"))["level"]
+    rounds = 3
+    lines = [
+        "| workload (2 threads, medians) | " + " | ".join(levels) + " | "
+        + " | ".join(f"{l} / avx2" for l in levels if l != "avx2") + " |",
+        "|---|" + "---:|" * (2 * len(levels) - 1),
+    ]
+    slower = []
+    for name, args in SIMD_WORKLOADS:
+        times = {l: [] for l in levels}
+        # Levels interleaved round by round, so a change in the machine's
+        # load falls on all of them alike.
+        for _ in range(rounds):
+            for level in levels:
+                out = run([GLINT, "bench", *args, "--octree-only", "--repeat", "3", "--format", "json"],
+                          env={**os.environ, "GLINT_SIMD": level})
+                times[level].append(json.loads(out)[0]["octree_on"]["render_s"])
+        med = {l: statistics.median(t) for l, t in times.items()}
+        cells = [f"{1000 * med[l]:,.1f} ms" + (" **(default)**" if l == default else "") for l in levels]
+        ratios = [f"{med[l] / med['avx2']:.2f}" for l in levels if l != "avx2"]
+        lines.append(f"| {name} | " + " | ".join(cells + ratios) + " |")
+        if "avx512" in med:
+            slower.append(med["avx512"] / med["avx2"])
+    note = ""
+    if slower:
+        note = (f"\n\nAVX-512 takes {min(slower):.2f} to {max(slower):.2f} times AVX2's time "
+                f"on these workloads ({rounds} rounds, levels interleaved; each cell the median "
+                f"of the rounds' medians of 3).")
+    return "\n".join(lines) + note + f"\n\n{stamp('simd')}"
+
+
+def orbit_run(scene, hz, seconds=5, env=None):
+    """One `glint view --orbit-bench` under Xvfb: its JSON report."""
+    out = run(["xvfb-run", "-a", "-s", "-screen 0 1440x900x24", "timeout", "300", GLINT, "view", scene,
+               "--orbit-bench", str(seconds), "--event-hz", str(hz), "--window", "1400x860"],
+              env={**os.environ, **(env or {})}, stderr=subprocess.DEVNULL)
+    return json.loads(out.strip().splitlines()[-1])
+
+
+def orbit():
+    """The viewer orbiting scenes/default.toml under Xvfb at 60 and 120 Hz."""
+    scene = "scenes/default.toml"
+    lines = [
+        "| pointer events | previews shown | shown per s | started | cancelled | latency p50 | latency p95 "
+        "| final pass | previews chosen (count, median) |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---|",
+    ]
+    for hz in (60, 120):
+        r = orbit_run(scene, hz)
+        choices = "; ".join(f"{c['preview']} ({c['count']}, {c['median_ms']} ms)"
+                            for c in sorted(r["choices"], key=lambda c: -c["count"]))
+        lines.append(
+            f"| {r['events']} at {hz} Hz | {r['previews_shown']} | {r['shown_per_s']} | "
+            f"{r['previews_started']} | {r['previews_cancelled']} | {r['latency_ms_p50']} ms | "
+            f"{r['latency_ms_p95']} ms | {r['final_ms']:,.0f} ms ({r['final_pass']}) | {choices} |"
+        )
+    return (
+        "\n".join(lines)
+        + f"\n\n`xvfb-run glint view {scene} --orbit-bench 5 --event-hz HZ --window 1400x860` "
+        f"(5 s of dragging, {r['threads']} render threads, SIMD {r['simd']}, image {r['image'][0]}x{r['image'][1]})."
+        + f"\n\n{stamp('orbit')}"
+    )
+
+
 SECTIONS = {
     "spd-table": spd_table,
     "spd-protocol": spd_protocol,
@@ -378,6 +459,8 @@ SECTIONS = {
     "cost-view": cost_view,
     "study": study,
     "prediction": prediction,
+    "simd": simd,
+    "orbit": orbit,
 }
 
 
