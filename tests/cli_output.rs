@@ -480,3 +480,37 @@ fn every_value_the_cli_accepts_is_read_back_and_one_past_it_refused() {
         assert!(!first.exists(), "{extra:?}: a file was written");
     }
 }
+
+/// `glint view --screenshot` checks its path as `glint render -o` does,
+/// before any window opens (so no display is needed here): a name that is
+/// not `.png`, or a folder that does not exist, is refused with exit 1,
+/// and an existing file is left as it was, a new name never created.
+#[cfg(feature = "gui")]
+#[test]
+fn a_screenshot_path_is_checked_before_the_window_and_no_file_is_touched() {
+    let tmp = common::temp_dir();
+    let d = tmp.path();
+    let keep = d.join("keep.jpg");
+    std::fs::write(&keep, b"precious").unwrap();
+    let fresh = d.join("fresh.bmp");
+    let missing = d.join("no such folder").join("shot.png");
+    for path in [&keep, &fresh, &missing] {
+        let o = Command::new(env!("CARGO_BIN_EXE_glint"))
+            .args(["view", &scene(), "--screenshot"])
+            .arg(path)
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .env_remove("WAYLAND_SOCKET")
+            .output()
+            .unwrap();
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{}: {err}", path.display());
+        assert!(err.contains("--screenshot"), "{err}");
+        assert!(
+            !err.contains("no display"),
+            "refused before the window: {err}"
+        );
+    }
+    assert_eq!(std::fs::read(&keep).unwrap(), b"precious");
+    assert!(!fresh.exists(), "no empty file left behind");
+}

@@ -41,6 +41,8 @@ pub struct ViewerOptions {
     /// Save a screenshot of the whole window here once the final pass is on
     /// screen, then exit.
     pub screenshot: Option<PathBuf>,
+    /// Where the screenshot's success or failure is reported.
+    pub screenshot_outcome: super::screenshot::ScreenshotOutcome,
     /// Frames to wait after the final pass before the screenshot.
     pub frames: u32,
     /// Render threads (0 = one per core).
@@ -177,9 +179,9 @@ impl GlintApp {
             inspect: InspectState::new(options.overlay_depth),
             compare_pending: options.compare,
             compare_difference: options.compare_difference,
-            screenshot: options
-                .screenshot
-                .map(|path| Screenshot::new(path, options.frames)),
+            screenshot: options.screenshot.map(|path| {
+                Screenshot::new(path, options.frames, options.screenshot_outcome.clone())
+            }),
             image_rect: None,
             input_serial: 0,
             orbit_bench: options.orbit_bench.map(OrbitBench::new),

@@ -17,7 +17,7 @@ pub mod orbit_bench;
 mod panels;
 pub mod pixel;
 mod save;
-mod screenshot;
+pub mod screenshot;
 pub mod state;
 mod timing;
 mod walk_view;

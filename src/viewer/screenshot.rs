@@ -1,13 +1,22 @@
 //! `glint view --screenshot`: once the final pass has been on screen for a
-//! few frames, save the whole window as PNG and close it.
+//! few frames, save the whole window as PNG and close it. The path is
+//! checked before the window opens (`glint view`), and the file is written
+//! like every output of glint: through a temporary file renamed into place,
+//! so a failure never leaves an existing file emptied or a new one half
+//! written.
 
 use std::path::PathBuf;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use super::worker::PassRecord;
 
+/// How the screenshot went: `None` until it was saved or failed; the
+/// caller reads it once the window has closed.
+pub type ScreenshotOutcome = Arc<Mutex<Option<Result<PathBuf, String>>>>;
+
 pub struct Screenshot {
     path: PathBuf,
+    outcome: ScreenshotOutcome,
     /// Frames to wait after the final pass (the panels settle).
     frames: u32,
     frames_since_final: u32,
@@ -15,9 +24,10 @@ pub struct Screenshot {
 }
 
 impl Screenshot {
-    pub fn new(path: PathBuf, frames: u32) -> Self {
+    pub fn new(path: PathBuf, frames: u32, outcome: ScreenshotOutcome) -> Self {
         Self {
             path,
+            outcome,
             frames: frames.max(1),
             frames_since_final: 0,
             requested: false,
@@ -53,12 +63,13 @@ impl Screenshot {
         if self.frames_since_final >= self.frames {
             self.requested = true;
             let path = self.path.clone();
+            let outcome = Arc::clone(&self.outcome);
             let close = ctx.clone();
             ctx.request_screenshot(move |image: Arc<egui::ColorImage>| {
-                match save(&path, &image) {
-                    Ok(()) => eprintln!("glint: saved window screenshot {}", path.display()),
-                    Err(e) => eprintln!("glint: screenshot failed: {e:#}"),
-                }
+                let result = save(&path, &image)
+                    .map(|()| path.clone())
+                    .map_err(|e| format!("{e:#}"));
+                *outcome.lock().unwrap_or_else(|e| e.into_inner()) = Some(result);
                 close.send_viewport_cmd(egui::ViewportCommand::Close);
             });
         }
@@ -66,11 +77,18 @@ impl Screenshot {
     }
 }
 
+/// The window's pixels as an opaque PNG, written as `glint render -o`
+/// writes (standard output for `-`, FIFOs directly, files atomically).
 fn save(path: &std::path::Path, image: &egui::ColorImage) -> anyhow::Result<()> {
     let [w, h] = image.size;
-    let rgba: Vec<u8> = image.pixels.iter().flat_map(|c| c.to_array()).collect();
-    let img = image::RgbaImage::from_raw(w as u32, h as u32, rgba)
-        .ok_or_else(|| anyhow::anyhow!("bad screenshot size {w}x{h}"))?;
-    img.save(path)?;
+    let rgb: Vec<u8> = image
+        .pixels
+        .iter()
+        .flat_map(|c| {
+            let [r, g, b, _] = c.to_array();
+            [r, g, b]
+        })
+        .collect();
+    crate::export::save_rgb_png(path, w as u32, h as u32, &rgb, None)?;
     Ok(())
 }

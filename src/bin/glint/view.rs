@@ -113,6 +113,13 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     };
     // Load once up front so a bad scene is a clear error, not a blank window.
     let scene = source.load()?;
+    // The screenshot's path is checked as `glint render -o` checks its
+    // output, before minutes of rendering: a PNG name in a folder that
+    // takes a new file, never the scene itself.
+    if let Some(shot) = &args.screenshot {
+        glint::export::check_output(shot, args.scene.as_deref())
+            .map_err(|e| anyhow!("--screenshot: {e}"))?;
+    }
     let (min_w, min_h) = glint::limits::MIN_WINDOW;
     anyhow::ensure!(
         args.window.0 >= min_w && args.window.1 >= min_h,
@@ -151,8 +158,10 @@ pub fn run(args: &ViewArgs) -> Result<()> {
             settings.height
         );
     }
+    let screenshot_outcome = glint::viewer::screenshot::ScreenshotOutcome::default();
     let options = ViewerOptions {
         screenshot: args.screenshot.clone(),
+        screenshot_outcome: screenshot_outcome.clone(),
         frames: args.frames,
         threads: args.threads,
         overrides,
@@ -197,7 +206,25 @@ pub fn run(args: &ViewArgs) -> Result<()> {
             Ok(Box::new(app))
         }),
     )
-    .map_err(|e| anyhow!("the viewer window failed: {e}"))
+    .map_err(|e| anyhow!("the viewer window failed: {e}"))?;
+    let Some(path) = &args.screenshot else {
+        return Ok(());
+    };
+    let outcome = screenshot_outcome
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .take();
+    match outcome {
+        Some(Ok(_)) => {
+            eprintln!("glint: saved window screenshot {}", path.display());
+            Ok(())
+        }
+        Some(Err(e)) => Err(anyhow!("the screenshot {} failed: {e}", path.display())),
+        None => Err(anyhow!(
+            "the window closed before the screenshot {} was taken",
+            path.display()
+        )),
+    }
 }
 
 /// `--orbit-bench`'s drag: more than nothing, at most ten minutes.
