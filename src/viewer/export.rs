@@ -129,7 +129,7 @@ fn utc_timestamp(secs: u64) -> String {
 /// (`XDG_PICTURES_DIR`, from the environment or `~/.config/user-dirs.dirs`,
 /// else `~/Pictures`) if it exists, else the scene file's directory, else
 /// the temporary directory.
-fn export_dir(source: &SceneSource) -> PathBuf {
+pub(super) fn export_dir(source: &SceneSource) -> PathBuf {
     let home = std::env::var_os("HOME").map(PathBuf::from);
     let from_user_dirs = || {
         let home = home.as_ref()?;

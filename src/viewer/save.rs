@@ -31,12 +31,15 @@ pub(super) fn is_nff(source: &SceneSource) -> bool {
 
 /// Where "Save scene as" writes: chosen in a save dialog, or, without one,
 /// a new name beside the scene file (`NAME-edited.toml`, then
-/// `NAME-edited-2.toml`, ...). `None` when the user cancels.
+/// `NAME-edited-2.toml`, ...); the built-in scene, which has no file, goes
+/// where exports go (the pictures directory, else the temporary one), never
+/// into the working directory, often a checkout. `None` when the user
+/// cancels.
 pub fn choose_path(source: &SceneSource) -> Option<PathBuf> {
     let folder = match source.path().and_then(Path::parent) {
         Some(d) if !d.as_os_str().is_empty() => d.to_owned(),
         Some(_) => PathBuf::from("."),
-        None => std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
+        None => super::export::export_dir(source),
     };
     let stem = source.stem();
     let (extension, filter) = if is_nff(source) {
@@ -140,5 +143,29 @@ fn write_builtin_mesh(destination: &Path) -> anyhow::Result<()> {
             &mesh,
             crate::scene::builtin::MESH,
         )?),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_built_in_scene_is_never_saved_into_the_working_directory() {
+        if file_dialog_available() {
+            return; // a dialog would ask; nothing to check headless
+        }
+        let path = choose_path(&SceneSource::BuiltIn).unwrap();
+        let folder = path.parent().unwrap();
+        assert_ne!(
+            std::fs::canonicalize(folder).unwrap(),
+            std::fs::canonicalize(std::env::current_dir().unwrap()).unwrap(),
+            "{}",
+            path.display()
+        );
+        assert!(
+            path.ends_with("default-edited.toml")
+                || path.to_string_lossy().contains("default-edited-")
+        );
     }
 }
