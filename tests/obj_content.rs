@@ -327,3 +327,38 @@ fn exporter_quirks_load() {
         "{message}"
     );
 }
+
+/// A model is something people share: its `mtllib` lines read libraries
+/// in the model's folder tree only, and a library that is no MTL file is
+/// named, never quoted.
+#[test]
+fn material_libraries_stay_in_the_model_folder_and_are_never_quoted() {
+    let tmp = temp_dir();
+    let root = tmp.path();
+    std::fs::create_dir(root.join("model")).unwrap();
+    std::fs::create_dir(root.join("model/materials")).unwrap();
+    write(root, "secret.txt", b"root:x:0:0:root:/root:/bin/bash\n");
+    write(root, "model/notes.txt", b"private words here\n");
+    write(root, "model/materials/red.mtl", b"newmtl red\nKd 1 0 0\n");
+    let secret = root.join("secret.txt");
+    let obj = format!(
+        "mtllib ../secret.txt\nmtllib {}\nmtllib notes.txt\nmtllib materials/../materials/red.mtl\n\
+         v -1 -1 0\nv 1 -1 0\nv 1 1 0\nusemtl red\nf 1 2 3\n",
+        secret.display()
+    );
+    write(root, "model/m.obj", obj.as_bytes());
+    let scene = load_file(&root.join("model/m.obj"));
+    let notes = scene.notes().join("\n");
+    assert!(!notes.contains("root:x"), "{notes}");
+    assert!(!notes.contains("private words"), "{notes}");
+    assert_eq!(
+        notes.matches("points outside the model's folder").count(),
+        2,
+        "{notes}"
+    );
+    assert!(notes.contains("not an MTL file"), "{notes}");
+    // The library inside the folder, reached through `..` that stays in
+    // it, is read.
+    let red = scene.materials.iter().find(|m| m.name == "red").unwrap();
+    assert_eq!(red.color, glint::math::DVec3::new(1.0, 0.0, 0.0));
+}

@@ -171,13 +171,25 @@ pub(super) fn read_libraries(
     let mut entries = Vec::new();
     for written in libraries {
         // One file name with spaces, or several names.
-        let whole = folder.join(written);
-        let names: Vec<std::path::PathBuf> = if files.read(&whole).is_ok() {
-            vec![whole]
-        } else {
-            written.split_whitespace().map(|n| folder.join(n)).collect()
-        };
-        for path in names {
+        let whole = inside_folder(folder, written);
+        let names: Vec<(&str, Option<std::path::PathBuf>)> =
+            if whole.as_ref().is_some_and(|p| files.read(p).is_ok()) {
+                vec![(written.as_str(), whole)]
+            } else {
+                written
+                    .split_whitespace()
+                    .map(|n| (n, inside_folder(folder, n)))
+                    .collect()
+            };
+        for (name, path) in names {
+            let Some(path) = path else {
+                notes.push(format!(
+                    "{}: `mtllib {name}` points outside the model's folder and is not read; \
+                     its materials are shown in the default material",
+                    obj_path.display()
+                ));
+                continue;
+            };
             match files.read(&path) {
                 Ok(bytes) => match mtl::parse(&bytes) {
                     Ok(mut found) => entries.append(&mut found),
@@ -194,6 +206,24 @@ pub(super) fn read_libraries(
         }
     }
     entries
+}
+
+/// A library named in an `mtllib` line, as a path in the model's folder
+/// tree: `None` for an absolute path or one whose `..` climbs out of the
+/// folder. A model is something people share, and its material libraries
+/// must not read files elsewhere on the machine that opens it.
+fn inside_folder(folder: &Path, written: &str) -> Option<std::path::PathBuf> {
+    use std::path::Component;
+    let mut depth = 0usize;
+    for component in Path::new(written).components() {
+        match component {
+            Component::Normal(_) => depth += 1,
+            Component::CurDir => {}
+            Component::ParentDir => depth = depth.checked_sub(1)?,
+            Component::RootDir | Component::Prefix(_) => return None,
+        }
+    }
+    Some(folder.join(written))
 }
 
 /// The scene's material index for each of `mesh`'s `usemtl` slots: its

@@ -74,7 +74,13 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Vec<MtlEntry>, ObjError> {
             continue;
         }
         let Some(entry) = entries.last_mut() else {
-            return Err(err(format!("`{keyword}` before the first `newmtl`")));
+            // A file that is no MTL at all (a library path pointing at
+            // anything else) is not quoted back: only MTL's own keywords are.
+            return Err(err(if is_mtl_keyword(&keyword) {
+                format!("`{keyword}` before the first `newmtl`")
+            } else {
+                "not an MTL file: its first statement is not an MTL keyword".to_owned()
+            }));
         };
         let numbers = || -> Result<Vec<f64>, ObjError> {
             rest.split(u8::is_ascii_whitespace)
@@ -208,6 +214,38 @@ pub(super) fn not_rendered(entries: &[MtlEntry]) -> BTreeMap<String, usize> {
         }
     }
     out
+}
+
+/// MTL's statements (the Wavefront MTL specification, and what exporters
+/// add: `Ke`, `Pr`, `Pm`, PBR maps), by keyword.
+fn is_mtl_keyword(keyword: &str) -> bool {
+    matches!(
+        keyword,
+        "newmtl"
+            | "Ka"
+            | "Kd"
+            | "Ks"
+            | "Ke"
+            | "Tf"
+            | "Ns"
+            | "Ni"
+            | "d"
+            | "Tr"
+            | "illum"
+            | "sharpness"
+            | "Pr"
+            | "Pm"
+            | "Ps"
+            | "Pc"
+            | "Pcr"
+            | "aniso"
+            | "anisor"
+            | "norm"
+            | "bump"
+            | "disp"
+            | "decal"
+            | "refl"
+    ) || keyword.starts_with("map_")
 }
 
 #[cfg(test)]
