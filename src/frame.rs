@@ -328,9 +328,47 @@ impl Frame {
     }
 }
 
+/// An RGBA image scaled to `w x h` by nearest neighbour (opaque black when
+/// there is nothing to scale).
+pub fn resample_rgba(rgba: &[u8], from_w: u32, from_h: u32, w: u32, h: u32) -> Vec<u8> {
+    let mut out = vec![0u8; (w * h * 4) as usize];
+    let usable = from_w > 0 && from_h > 0 && rgba.len() == (from_w * from_h * 4) as usize;
+    for y in 0..h {
+        for x in 0..w {
+            let dst = ((y * w + x) * 4) as usize;
+            if usable {
+                let sx = (x as u64 * from_w as u64 / w as u64) as u32;
+                let sy = (y as u64 * from_h as u64 / h as u64) as u32;
+                let src = ((sy * from_w + sx) * 4) as usize;
+                out[dst..dst + 4].copy_from_slice(&rgba[src..src + 4]);
+            } else {
+                out[dst + 3] = 255;
+            }
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn resampling_picks_the_nearest_source_pixel() {
+        // A 2x2 image of four colours, doubled: each becomes a 2x2 block.
+        let rgba: Vec<u8> = (0..4u8).flat_map(|k| [k, 10 * k, 20 * k, 255]).collect();
+        let big = resample_rgba(&rgba, 2, 2, 4, 4);
+        let at = |x: usize, y: usize| big[(y * 4 + x) * 4];
+        let blocks: Vec<u8> = (0..4)
+            .flat_map(|y| (0..4).map(move |x| (x, y)))
+            .map(|(x, y)| at(x, y))
+            .collect();
+        assert_eq!(blocks, [0, 0, 1, 1, 0, 0, 1, 1, 2, 2, 3, 3, 2, 2, 3, 3]);
+        // Halved back: the top-left pixel of each block.
+        assert_eq!(resample_rgba(&big, 4, 4, 2, 2), rgba);
+        // Nothing usable (a buffer of another size): opaque black.
+        assert_eq!(resample_rgba(&rgba, 3, 3, 1, 1), [0, 0, 0, 255]);
+    }
 
     #[test]
     fn a_tile_of_the_shaded_view_encodes_like_the_whole_frame() {

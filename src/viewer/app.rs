@@ -8,6 +8,8 @@ use std::time::Instant;
 
 use egui::{Color32, Sense, TextureHandle, TextureOptions};
 
+mod scene_files;
+
 use super::command::Command;
 use super::compare::{Compare, CompareMode, DiffStats};
 use super::inspect::InspectState;
@@ -20,7 +22,7 @@ use super::screenshot::Screenshot;
 pub use super::state::{CompareSetting, SceneSource};
 use super::state::{EditState, Magnification, Snapshot};
 use super::worker::{Job, Preview, Worker};
-use super::{budget, export, input, panels, save, timing};
+use super::{budget, export, input, panels, timing};
 use crate::accel::{Octree, OctreeParams};
 use crate::camera::CameraSpec;
 use crate::render::{Renderer, UnitCosts};
@@ -671,208 +673,6 @@ impl GlintApp {
         &self.title
     }
 
-    /// Asks before an action drops unsaved edits.
-    fn discard_prompt_ui(&mut self, ctx: &egui::Context) {
-        let Some(action) = self.discarding.clone() else {
-            return;
-        };
-        let verb = match &action {
-            Discarding::Reload => "reload the scene file",
-            Discarding::Open(_) => "open another scene",
-            Discarding::Quit => "quit",
-        };
-        let mut choice = None;
-        egui::Modal::new(egui::Id::unique("discard-edits")).show(ctx, |ui| {
-            ui.heading("Unsaved edits");
-            ui.label(format!(
-                "{} has edits that are not saved. Discard them and {verb}?",
-                self.edit.source.display_name()
-            ));
-            ui.horizontal(|ui| {
-                if ui.button("Save first").clicked() {
-                    choice = Some(true);
-                }
-                if ui.button("Discard").clicked() {
-                    choice = Some(false);
-                }
-                if ui.button("Cancel").clicked() || ui.input(|i| i.key_pressed(egui::Key::Escape)) {
-                    self.discarding = None;
-                }
-            });
-        });
-        let Some(save_first) = choice else {
-            return;
-        };
-        self.discarding = None;
-        if save_first {
-            self.save();
-            if self.unsaved() {
-                return; // not saved (cancelled or failed): do nothing more
-            }
-        }
-        match action {
-            Discarding::Reload => self.reload(),
-            Discarding::Open(path) => self.open(path),
-            Discarding::Quit => {
-                self.saved = self.edit.snapshot();
-                ctx.send_viewport_cmd(egui::ViewportCommand::Close);
-            }
-        }
-    }
-
-    /// Writes the edits into the scene's TOML or NFF file; a scene without
-    /// one (built in, an OBJ file) is saved as a new TOML file.
-    pub fn save(&mut self) {
-        match self.edit.source.path() {
-            Some(p) if save::saves_in_place(&self.edit.source) => {
-                let p = p.to_owned();
-                self.save_to(&p)
-            }
-            _ => self.save_as(),
-        }
-    }
-
-    /// Writes the scene with its edits to a new file (NFF for an NFF
-    /// scene, TOML otherwise) and goes on editing that file.
-    pub fn save_as(&mut self) {
-        if let Some(path) = save::choose_path(&self.edit.source) {
-            self.save_to(&path);
-        }
-    }
-
-    /// Saves to `path`; the saved file becomes the scene's source.
-    pub fn save_to(&mut self, path: &Path) {
-        match save::save(&self.edit, path) {
-            Ok(saved) => {
-                let shown = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_owned());
-                let name = saved.scene.name.clone();
-                self.edit.loaded = Arc::new(saved.scene);
-                self.edit.source = SceneSource::File(path.to_owned());
-                // The scene text exports record is now the saved file's
-                // (no re-render: the picture is the same).
-                let scene = Arc::make_mut(&mut self.edit.scene);
-                scene.source_text = Arc::clone(&self.edit.loaded.source_text);
-                scene.name = name;
-                let mut baseline = self.edit.snapshot();
-                // What the file holds is saved; edits it could not hold
-                // stay marked (the camera is compared as edited: an NFF
-                // angle may round the field of view in its last bit).
-                let reloaded = Arc::clone(&self.edit.loaded);
-                if reloaded.lights.len() == baseline.lights.len() {
-                    baseline.lights.clone_from(&reloaded.lights);
-                }
-                if reloaded.materials.len() == baseline.materials.len() {
-                    baseline.materials.clone_from(&reloaded.materials);
-                } else if let Err(e) = self.install_scene((*reloaded).clone(), false) {
-                    // NFF made equal materials one: the saved scene, which
-                    // renders the same, is the one to go on editing.
-                    self.say(format!("cannot show the saved scene: {e:#}"), true);
-                } else {
-                    baseline = self.edit.snapshot();
-                }
-                // Settings the file cannot hold keep the file's value in
-                // the baseline, so they stay marked unsaved.
-                let file = reloaded.render_settings();
-                let b = &mut baseline.settings;
-                for what in &saved.left_out {
-                    match what.as_str() {
-                        "samples" => (b.samples, b.adaptive) = (file.samples, file.adaptive),
-                        "max depth" => b.max_depth = file.max_depth,
-                        "colours" => b.colors = file.colors,
-                        "sides" => b.sides = file.sides,
-                        "the octree switch" => b.use_octree = file.use_octree,
-                        _ => {}
-                    }
-                }
-                if saved.left_out.is_empty() {
-                    self.say(format!("saved {}", shown.display()), false);
-                } else {
-                    self.say(
-                        format!(
-                            "saved {}, without {}: the file's format has no place for them (export a PNG to keep them)",
-                            shown.display(),
-                            saved.left_out.join(", ")
-                        ),
-                        true,
-                    );
-                }
-                self.saved = baseline;
-            }
-            Err(e) => self.say(format!("cannot save {}: {e:#}", path.display()), true),
-        }
-    }
-
-    /// Re-reads the scene file, keeping the camera; a failure keeps the
-    /// current scene on screen.
-    pub fn reload(&mut self) {
-        match self
-            .edit
-            .source
-            .load()
-            .and_then(|scene| self.install_scene(scene, false))
-        {
-            Ok(()) => {
-                // The camera stays where the user put it, which the file
-                // may not say.
-                self.saved = Snapshot {
-                    camera: self.edit.loaded.camera,
-                    ..self.edit.snapshot()
-                };
-                self.say(format!("reloaded {}", self.edit.scene.name), false)
-            }
-            Err(e) => self.say(
-                format!("reload failed, keeping the previous scene: {e:#}"),
-                true,
-            ),
-        }
-    }
-
-    /// Opens another scene file.
-    pub fn open(&mut self, path: PathBuf) {
-        let source = SceneSource::File(path);
-        match source
-            .load()
-            .and_then(|scene| self.install_scene(scene, true))
-        {
-            Ok(()) => {
-                self.edit.source = source;
-                self.saved = self.edit.snapshot();
-                self.say(format!("opened {}", self.edit.scene.name), false);
-                for note in self.edit.scene.notes() {
-                    self.say(format!("note: {note}"), false);
-                }
-            }
-            Err(e) => self.say(format!("cannot open: {e:#}"), true),
-        }
-    }
-
-    fn install_scene(&mut self, scene: Scene, take_camera: bool) -> anyhow::Result<()> {
-        let (octree, seconds) = build_octree(&scene)?;
-        let edit = &mut self.edit;
-        if take_camera {
-            edit.camera = scene.camera;
-            // The new scene's own settings (its colour convention among
-            // them), keeping the view, the octree switch and the protocol.
-            edit.settings = RenderSettings {
-                view: edit.settings.view,
-                use_octree: edit.settings.use_octree,
-                ..scene.render_settings()
-            }
-            .with_protocol(edit.settings.protocol);
-        }
-        edit.loaded = Arc::new(scene.clone());
-        edit.scene = Arc::new(scene);
-        edit.scene_version += 1;
-        // Undo does not reach into another scene (or an earlier version
-        // of this one).
-        self.undoer = Default::default();
-        self.octree = Arc::new(octree);
-        self.build_seconds = seconds;
-        // Measured again on the new scene once it has rendered.
-        self.unit_costs = None;
-        Ok(())
-    }
-
     pub fn octree(&self) -> &Octree {
         &self.octree
     }
@@ -945,23 +745,6 @@ impl GlintApp {
                 Renderer::with_camera(&self.edit.scene, &self.octree, settings, &self.edit.camera)
             {
                 self.unit_costs = UnitCosts::measure(&renderer, &self.octree).ok();
-            }
-        }
-    }
-
-    fn open_dialog(&mut self) {
-        if !export::file_dialog_available() {
-            self.say("no file dialog is available here (no desktop portal); pass the scene on the command line: glint view SCENE", true);
-            return;
-        }
-        if let Some(path) = rfd::FileDialog::new()
-            .add_filter("scenes and models", &["toml", "nff", "obj"])
-            .pick_file()
-        {
-            if self.unsaved() {
-                self.discarding = Some(Discarding::Open(path));
-            } else {
-                self.open(path);
             }
         }
     }

@@ -14,13 +14,15 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{Receiver, Sender, channel};
-use std::sync::{Arc, Mutex, Weak};
+use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
+use super::pass_cache::{CachedPass, PassCache, PassKey};
+pub use super::preview::{Preview, Reflections};
 use crate::accel::Octree;
 use crate::camera::CameraSpec;
-use crate::frame::{Frame, rgb_to_rgba};
+use crate::frame::{Frame, resample_rgba, rgb_to_rgba};
 use crate::render::{FinishedPass, FinishedTile, PassInfo, PassOptions, PassWatch, Renderer};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
@@ -42,6 +44,18 @@ pub struct Job {
     /// counts pointer events), carried to the display buffer so the UI
     /// can tell how new a shown frame is.
     pub serial: u64,
+}
+
+impl Job {
+    /// What decides pass `pass` of this job, for the pass cache.
+    fn pass_key(&self, pass: crate::render::PassKind) -> PassKey {
+        PassKey::of(
+            (&self.scene, &self.octree),
+            self.camera,
+            self.settings,
+            pass,
+        )
+    }
 }
 
 /// Which pass produced a buffer.
@@ -73,48 +87,6 @@ impl PassKind {
             PassKind::SixteenSamples => "16 samples".into(),
             PassKind::Corners => "SPD corners".into(),
         }
-    }
-}
-
-/// How a preview while moving simplifies the image to fit the frame budget.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Preview {
-    /// 1/`divisor` of the resolution on each axis.
-    pub divisor: u32,
-    /// How deep reflection and refraction rays go.
-    pub reflections: Reflections,
-    pub shadows: bool,
-}
-
-/// Reflection and refraction in a preview.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Reflections {
-    /// To the scene's depth.
-    All,
-    /// One bounce: the eye ray's reflection and refraction rays, not
-    /// theirs (glass and mirrors keep their look, deeper paths go).
-    OneBounce,
-    /// None: the eye ray only.
-    Off,
-}
-
-impl Preview {
-    /// E.g. "1/2, no reflections".
-    pub fn describe(&self) -> String {
-        let mut s = if self.divisor == 1 {
-            "full resolution".to_string()
-        } else {
-            format!("1/{}", self.divisor)
-        };
-        match self.reflections {
-            Reflections::All => {}
-            Reflections::OneBounce => s.push_str(", one bounce"),
-            Reflections::Off => s.push_str(", no reflections"),
-        }
-        if !self.shadows {
-            s.push_str(", no shadows");
-        }
-        s
     }
 }
 
@@ -207,7 +179,7 @@ struct Shared {
     /// What went wrong in the worker, for the status bar (taken by the UI).
     failure: Mutex<Option<String>>,
     /// Recent finished passes, shown again without rendering.
-    cache: Mutex<PassCache>,
+    cache: Mutex<PassCache<PassRecord>>,
     /// The preview in flight and the one waiting for it.
     previews: Mutex<PreviewQueue>,
     previews_started: AtomicU64,
@@ -230,111 +202,6 @@ pub struct PreviewCounts {
     pub started: u64,
     /// Previews that finished and went into the display buffer.
     pub completed: u64,
-}
-
-/// What decides a pass: the scene (by identity: an edit makes a new one),
-/// the camera, the settings as the pass traces them (its own sampling, the
-/// shaded view for aa-need) and, for the cost views, the octree itself
-/// (its tests are what they show). The octree switch is part of the
-/// settings although the pixels do not depend on it: its time is what a
-/// user toggles it to see.
-///
-/// Scene and octree are held weakly: the cache does not keep an edited-away
-/// scene alive, and the allocation a weak pointer holds cannot be reused by
-/// another scene, so equal pointers are the same scene.
-#[derive(Clone)]
-struct PassKey {
-    scene: Weak<Scene>,
-    octree: Option<Weak<Octree>>,
-    camera: CameraSpec,
-    settings: RenderSettings,
-    pass: crate::render::PassKind,
-}
-
-impl PassKey {
-    fn of(job: &Job, pass: crate::render::PassKind) -> Self {
-        use crate::render::PassKind as Engine;
-        use crate::settings::ViewMode;
-        let mut settings = job.settings;
-        if settings.view == ViewMode::AaNeed {
-            settings.view = ViewMode::Shaded;
-        }
-        // The aa-need view's grid pass traces 16 samples, whatever the
-        // setting (as the renderer does).
-        let grid = if job.settings.view == ViewMode::AaNeed {
-            16
-        } else {
-            job.settings.samples
-        };
-        match pass {
-            Engine::OneSample => (settings.samples, settings.adaptive) = (1, false),
-            Engine::Grid => (settings.samples, settings.adaptive) = (grid, false),
-            Engine::Refine => (settings.samples, settings.adaptive) = (grid, true),
-            Engine::Corners => {}
-        }
-        let counts_tests = matches!(settings.view, ViewMode::Cost | ViewMode::CostSteps);
-        PassKey {
-            scene: Arc::downgrade(&job.scene),
-            octree: counts_tests.then(|| Arc::downgrade(&job.octree)),
-            camera: job.camera,
-            settings,
-            pass,
-        }
-    }
-
-    fn matches(&self, other: &PassKey) -> bool {
-        Weak::ptr_eq(&self.scene, &other.scene)
-            && match (&self.octree, &other.octree) {
-                (Some(a), Some(b)) => Weak::ptr_eq(a, b),
-                (None, None) => true,
-                _ => false,
-            }
-            && self.camera == other.camera
-            && self.settings == other.settings
-            && self.pass == other.pass
-    }
-}
-
-struct CachedPass {
-    key: PassKey,
-    frame: Frame,
-    record: PassRecord,
-}
-
-/// The last few finished passes, newest last, within a memory bound: a
-/// view or anti-aliasing switch back to an image already rendered shows
-/// it at once.
-#[derive(Default)]
-struct PassCache {
-    entries: Vec<CachedPass>,
-}
-
-impl PassCache {
-    /// At most this many frames of f64 pixels are kept (a 4x4-inch image
-    /// at 800x600 is 11 MiB).
-    const MAX_BYTES: usize = 256 << 20;
-
-    fn bytes(frame: &Frame) -> usize {
-        frame.pixels.len() * std::mem::size_of_val(&crate::math::DVec3::ZERO)
-    }
-
-    fn insert(&mut self, pass: CachedPass) {
-        if Self::bytes(&pass.frame) > Self::MAX_BYTES / 2 {
-            return;
-        }
-        // Passes of scenes nobody holds any more can never be asked for.
-        self.entries
-            .retain(|e| !e.key.matches(&pass.key) && e.key.scene.strong_count() > 0);
-        self.entries.push(pass);
-        let mut total: usize = self.entries.iter().map(|e| Self::bytes(&e.frame)).sum();
-        while total > Self::MAX_BYTES {
-            total -= Self::bytes(&self.entries.remove(0).frame);
-        }
-    }
-
-    fn find(&self, key: &PassKey) -> Option<&CachedPass> {
-        self.entries.iter().rev().find(|e| e.key.matches(key))
-    }
 }
 
 /// Tiles arrive far faster than a screen refreshes; asking for a repaint
@@ -651,12 +518,12 @@ fn show_cached(
     let aa_need = job.settings.view == ViewMode::AaNeed;
     let (frame, records, one_sample) = {
         let cache = shared.cache.lock().unwrap_or_else(|e| e.into_inner());
-        let Some(final_pass) = cache.find(&PassKey::of(job, last)) else {
+        let Some(final_pass) = cache.find(&job.pass_key(last)) else {
             return false;
         };
         let mut records = vec![final_pass.record];
         let one = (last != Engine::OneSample)
-            .then(|| cache.find(&PassKey::of(job, Engine::OneSample)))
+            .then(|| cache.find(&job.pass_key(Engine::OneSample)))
             .flatten();
         if let Some(one) = one {
             // The timing panel shows the 1-sample pass beside the last.
@@ -844,7 +711,7 @@ impl PassWatch for Display<'_> {
                     .lock()
                     .unwrap_or_else(|e| e.into_inner())
                     .insert(CachedPass {
-                        key: PassKey::of(self.job, pass.info.kind),
+                        key: self.job.pass_key(pass.info.kind),
                         frame: pass.traced.clone(),
                         record,
                     });
@@ -896,47 +763,9 @@ fn count_tile(shared: &Shared, generation: u64) {
     }
 }
 
-/// An RGBA image scaled to `w x h` by nearest neighbour (opaque black when
-/// there is nothing to scale).
-fn resample_rgba(rgba: &[u8], from_w: u32, from_h: u32, w: u32, h: u32) -> Vec<u8> {
-    let mut out = vec![0u8; (w * h * 4) as usize];
-    let usable = from_w > 0 && from_h > 0 && rgba.len() == (from_w * from_h * 4) as usize;
-    for y in 0..h {
-        for x in 0..w {
-            let dst = ((y * w + x) * 4) as usize;
-            if usable {
-                let sx = (x as u64 * from_w as u64 / w as u64) as u32;
-                let sy = (y as u64 * from_h as u64 / h as u64) as u32;
-                let src = ((sy * from_w + sx) * 4) as usize;
-                out[dst..dst + 4].copy_from_slice(&rgba[src..src + 4]);
-            } else {
-                out[dst + 3] = 255;
-            }
-        }
-    }
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn resampling_picks_the_nearest_source_pixel() {
-        // A 2x2 image of four colours, doubled: each becomes a 2x2 block.
-        let rgba: Vec<u8> = (0..4u8).flat_map(|k| [k, 10 * k, 20 * k, 255]).collect();
-        let big = resample_rgba(&rgba, 2, 2, 4, 4);
-        let at = |x: usize, y: usize| big[(y * 4 + x) * 4];
-        let blocks: Vec<u8> = (0..4)
-            .flat_map(|y| (0..4).map(move |x| (x, y)))
-            .map(|(x, y)| at(x, y))
-            .collect();
-        assert_eq!(blocks, [0, 0, 1, 1, 0, 0, 1, 1, 2, 2, 3, 3, 2, 2, 3, 3]);
-        // Halved back: the top-left pixel of each block.
-        assert_eq!(resample_rgba(&big, 4, 4, 2, 2), rgba);
-        // Nothing usable (a buffer of another size): opaque black.
-        assert_eq!(resample_rgba(&rgba, 3, 3, 1, 1), [0, 0, 0, 255]);
-    }
 
     #[test]
     fn passes_describe_what_they_dropped() {
