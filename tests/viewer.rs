@@ -443,6 +443,39 @@ fn pin_as_a_then_octree_off_reads_zero_pixels_differ() {
     );
 }
 
+/// The octree switch always renders, and while the new pass runs the
+/// timing panel shows no figure of the image before: its rows read
+/// "rendering…", nothing is "kept", the status is not "done".
+#[test]
+fn an_octree_toggle_renders_and_the_panel_waits_for_the_new_figures() {
+    let mut app = app_for("scenes/default.toml", 160, 120);
+    app.set_anti_aliasing(AntiAliasing::Off);
+    let mut h = harness(app);
+    settle(&mut h);
+    let labels =
+        |h: &Harness<'static, GlintApp>, text: &str| h.query_all_by_label_contains(text).count();
+    for on in [false, true, false] {
+        h.get_by_label("Octree").click();
+        h.run_steps(2);
+        assert_eq!(h.state().settings().use_octree, on);
+        let generation = h.state().worker().generation();
+        if !h.state().final_pass_shown() {
+            // Mid-pass (the brute-force passes take seconds here).
+            assert!(labels(&h, "rendering…") >= 1, "octree {on}: the rows wait");
+            assert_eq!(labels(&h, "kept"), 0, "octree {on}: no kept figure");
+            assert_eq!(labels(&h, "done:"), 0, "octree {on}: not done");
+        }
+        settle(&mut h);
+        assert!(
+            h.state().worker().tiles_started(generation) > 0,
+            "octree {on}: the switch rendered"
+        );
+        h.run_steps(2);
+        assert_eq!(labels(&h, "kept"), 0, "octree {on}: rendered, not kept");
+        assert_eq!(labels(&h, "rendering…"), 0, "octree {on}: figures in");
+    }
+}
+
 /// Dragging sends every frame's camera to the worker, yet cancels no
 /// preview: each generation the drag uses is a preview that started (a
 /// preview asked for while one renders waits instead of bumping it), and

@@ -367,6 +367,7 @@ fn materials_ui(edit: &mut EditState, ui: &mut egui::Ui) {
 pub fn status_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) -> Vec<Command> {
     let mut commands = Vec::new();
     ui.horizontal(|ui| {
+        let newest = info.worker.generation();
         let status = info.worker.try_with_buffer(|b| {
             (
                 b.pass,
@@ -375,17 +376,24 @@ pub fn status_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) -> Vec<
                 b.finished,
                 b.pass_started.map(|t| t.elapsed().as_secs_f64()),
                 b.stopped,
+                b.generation == newest,
             )
         });
         match status {
-            Some((Some(pass), done, total, _, _, true)) => {
+            // The buffer describes the image before until the new job's
+            // first pass starts: that image is neither "done" nor the
+            // progress of the new one.
+            Some((Some(pass), .., false, false)) if !matches!(pass, PassKind::Preview(_)) => {
+                ui.label("starting the new image…");
+            }
+            Some((Some(pass), done, total, _, _, true, _)) => {
                 let pct = 100.0 * done as f64 / total.max(1) as f64;
                 ui.label(format!(
                     "stopped: {} at {pct:.0}% (any change renders again)",
                     pass.label()
                 ));
             }
-            Some((Some(pass), done, total, finished, elapsed, false)) => {
+            Some((Some(pass), done, total, finished, elapsed, false, _)) => {
                 if let PassKind::Preview(p) = pass {
                     // A drag's frames: the full passes follow on release.
                     ui.label(format!(

@@ -87,19 +87,31 @@ fn timing_grid_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
     // Figures compare passes of one image only: those of the newest
     // generation that has a full pass (a preview is not one), so a toggle
     // never shows a new 1-sample time against an old 16-sample time.
-    let shown = history
+    // The newest full job's image: while it renders, its rows read
+    // "rendering…" rather than the figures of the image before (an octree
+    // toggle must never show the old tree's time beside the new setting).
+    let newest_record = history
         .iter()
         .rev()
         .find(|r| !matches!(r.kind, PassKind::Preview(_)))
         .map(|r| r.generation);
+    let submitted = info.worker.full_generation();
+    let shown = match newest_record {
+        Some(g) if g >= submitted => Some(g),
+        _ if submitted > 0 => Some(submitted),
+        other => other,
+    };
     let of_shown = |kind: PassKind| {
         history
             .iter()
             .rev()
             .find(|r| Some(r.generation) == shown && r.kind == kind)
     };
-    let stopped = info.worker.try_with_buffer(|b| b.stopped).unwrap_or(false);
-    let rendering = info.worker.generation() != shown.unwrap_or(0) && !stopped;
+    let (stopped, finished) = info
+        .worker
+        .try_with_buffer(|b| (b.stopped, b.generation == shown.unwrap_or(0) && b.finished))
+        .unwrap_or((false, false));
+    let rendering = !finished && !stopped;
     egui::Grid::new("timing-grid")
         .num_columns(2)
         .max_col_width(170.0)

@@ -184,6 +184,11 @@ struct Shared {
     previews: Mutex<PreviewQueue>,
     previews_started: AtomicU64,
     previews_completed: AtomicU64,
+    /// The newest full job's generation ([`Worker::full_generation`]).
+    full_generation: AtomicU64,
+    /// The octree switch of the last full job rendered: a job that flips
+    /// it always renders, its time being what the user toggled to see.
+    last_octree_switch: Mutex<Option<bool>>,
 }
 
 /// While the user drags: the generation of the preview in flight (sent or
@@ -254,6 +259,8 @@ impl Worker {
             previews: Mutex::new(PreviewQueue::default()),
             previews_started: AtomicU64::new(0),
             previews_completed: AtomicU64::new(0),
+            full_generation: AtomicU64::new(0),
+            last_octree_switch: Mutex::new(None),
         });
         let (tx, rx) = channel();
         let thread_shared = Arc::clone(&shared);
@@ -291,7 +298,17 @@ impl Worker {
     pub fn submit(&self, job: Job) -> u64 {
         let mut previews = self.previews();
         *previews = PreviewQueue::default();
-        self.send(job)
+        let generation = self.send(job);
+        self.shared
+            .full_generation
+            .store(generation, Ordering::SeqCst);
+        generation
+    }
+
+    /// The generation of the newest full (not preview) job submitted: the
+    /// image whose figures the timing panel shows, or "rendering…" for.
+    pub fn full_generation(&self) -> u64 {
+        self.shared.full_generation.load(Ordering::SeqCst)
     }
 
     /// Renders the preview `job` (a job with [`Job::preview`]) without
@@ -481,8 +498,19 @@ fn render_job(shared: &Shared, generation: u64, job: &Job) {
             return;
         }
     };
-    if job.preview.is_none() && show_cached(shared, generation, job, &renderer.plan(true)) {
-        return;
+    if job.preview.is_none() {
+        let switched = {
+            let mut last = shared
+                .last_octree_switch
+                .lock()
+                .unwrap_or_else(|e| e.into_inner());
+            let switched = last.is_some_and(|on| on != job.settings.use_octree);
+            *last = Some(job.settings.use_octree);
+            switched
+        };
+        if !switched && show_cached(shared, generation, job, &renderer.plan(true)) {
+            return;
+        }
     }
     if job.preview.is_some() {
         shared.previews_started.fetch_add(1, Ordering::SeqCst);
