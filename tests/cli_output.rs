@@ -514,3 +514,26 @@ fn a_screenshot_path_is_checked_before_the_window_and_no_file_is_touched() {
     assert_eq!(std::fs::read(&keep).unwrap(), b"precious");
     assert!(!fresh.exists(), "no empty file left behind");
 }
+
+/// A flag that would have no effect is refused with the reason, not
+/// accepted silently: `--overlay-depth` without an overlay to draw, and
+/// `--compare-difference` without `--compare`.
+#[test]
+fn flags_without_effect_are_refused() {
+    let tmp = common::temp_dir();
+    let mut args = small(&tmp.path().join("x.png"));
+    args.extend(["--overlay-depth".into(), "3".into()]);
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--overlay octree"), "{}", stderr(&o));
+    assert!(!tmp.path().join("x.png").exists());
+    args.extend(["--overlay".into(), "octree".into()]);
+    let o = run(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    #[cfg(feature = "gui")]
+    {
+        let o = glint(&["view", &scene(), "--compare-difference"]);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(stderr(&o).contains("--compare"), "{}", stderr(&o));
+    }
+}

@@ -278,6 +278,12 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
     let pool = thread_pool(args.threads)?;
     let threads = pool.current_num_threads();
     let build_start = Instant::now();
+    // A depth with no overlay to draw would be ignored without a word.
+    anyhow::ensure!(
+        args.overlay_depth.is_none() || overlay_depth.is_some(),
+        "--overlay-depth sets how deep the octree overlay draws: add --overlay octree \
+         (or render again a PNG that recorded an overlay, with --from-png)"
+    );
     let octree = if settings.use_octree || overlay_depth.is_some() {
         pool.install(|| Octree::build(&scene.shapes, scene.octree_params))
             .with_context(|| format!("cannot build the octree of {scene_name}"))?

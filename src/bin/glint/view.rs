@@ -57,8 +57,8 @@ pub struct ViewArgs {
     /// flipped and pinned, then B renders as given.
     #[arg(long, value_enum)]
     pub compare: Option<CompareArg>,
-    /// Show the comparison as |A - B| instead of a split.
-    #[arg(long)]
+    /// Show the comparison as |A - B| instead of a split (with --compare).
+    #[arg(long, requires = "compare")]
     pub compare_difference: bool,
     /// Benchmark orbiting: once the first image is complete, drag the
     /// camera round for SECONDS with synthetic pointer events, then print
