@@ -99,9 +99,12 @@ fn read_record_from<R: std::io::BufRead + std::io::Seek>(
     // glint writes its text chunks before the image data, so reading the
     // header chunks is enough: the pixels are never decoded (a crafted
     // header cannot make this allocate).
-    let reader = png::Decoder::new(source)
-        .read_info()
-        .map_err(|e| decode(e.to_string()))?;
+    let reader = png::Decoder::new(source).read_info().map_err(|e| match e {
+        png::DecodingError::IoError(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => {
+            decode(TRUNCATED.to_owned())
+        }
+        e => decode(e.to_string()),
+    })?;
     let info = reader.info();
     let text = |key: &'static str| -> Result<String, ExportError> {
         let chunk = info
@@ -182,6 +185,10 @@ fn decompress(data: &[u8]) -> Result<String, String> {
 /// The data of the first chunk of type `kind` before the image data, if
 /// any. The png crate skips chunks it does not know, so glint walks the
 /// chunk list itself (PNG spec, section 5.3: length, type, data, CRC).
+/// What a PNG that ends early is called (the reader's own words, "failed
+/// to fill whole buffer", say nothing to a user).
+const TRUNCATED: &str = "the file is truncated: it ends before the PNG's header chunks do (an interrupted copy or download?)";
+
 fn private_chunk(
     mut file: impl std::io::Read,
     path: &Path,
@@ -192,9 +199,15 @@ fn private_chunk(
         path: path.to_owned(),
         message: message.to_owned(),
     };
-    let read_error = |source| ExportError::Read {
-        path: path.to_owned(),
-        source,
+    let read_error = |source: std::io::Error| {
+        if source.kind() == std::io::ErrorKind::UnexpectedEof {
+            decode(TRUNCATED)
+        } else {
+            ExportError::Read {
+                path: path.to_owned(),
+                source,
+            }
+        }
     };
     let mut signature = [0u8; 8];
     file.read_exact(&mut signature).map_err(read_error)?;
@@ -253,5 +266,21 @@ mod tests {
         assert!(decompress(b"not zlib").is_err());
         let not_utf8 = compress(&[0xff, 0xfe, 0x00]).unwrap();
         assert!(decompress(&not_utf8).unwrap_err().contains("UTF-8"));
+    }
+
+    #[test]
+    fn a_png_that_ends_early_is_called_truncated() {
+        let path = Path::new("t.png");
+        let mut bytes = Vec::new();
+        write_png(&mut bytes, path, 4, 3, &[7u8; 4 * 3 * 3], None).unwrap();
+        for cut in [0, 5, 8, 20, 40] {
+            let e = read_record_bytes(&bytes[..cut], path)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("truncated"), "{cut} bytes: {e}");
+        }
+        // Whole, it reads on to the missing record: not truncated.
+        let e = read_record_bytes(&bytes, path).unwrap_err().to_string();
+        assert!(!e.contains("truncated"), "{e}");
     }
 }
