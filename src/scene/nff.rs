@@ -145,6 +145,12 @@ impl<'a> Tokens<'a> {
         })
     }
 
+    /// Line and column of the token just read.
+    fn last_place(&self) -> (usize, usize) {
+        let t = &self.tokens[self.next - 1];
+        (t.line, t.column)
+    }
+
     /// Line and column of the next token (or of the entity, at the end).
     fn peek_place(&self) -> (usize, usize) {
         self.tokens
@@ -307,10 +313,12 @@ fn parse_into(
                 tokens.label("angle")?;
                 let angle = tokens.number("angle")?;
                 let [angle_at] = tokens.last();
+                let angle_place = tokens.last_place();
                 tokens.label("hither")?;
                 let _hither = tokens.number("hither")?;
                 tokens.label("resolution")?;
                 let limit = MAX_IMAGE_SIDE as usize;
+                let resolution_place = tokens.peek_place();
                 let w = tokens.count("resolution", limit)?;
                 let h = tokens.count("resolution", limit)?;
                 if let Some(layout) = layout.as_deref_mut() {
@@ -322,7 +330,9 @@ fn parse_into(
                         resolution: tokens.last(),
                     });
                 }
+                // Errors point at the bad value, not at the `v` line.
                 if w == 0 || h == 0 {
+                    let (line, column) = resolution_place;
                     return Err(tokens.error_at(
                         line,
                         column,
@@ -331,6 +341,7 @@ fn parse_into(
                     ));
                 }
                 if !(angle > 0.0 && angle < 180.0) {
+                    let (line, column) = angle_place;
                     return Err(tokens.error_at(
                         line,
                         column,
@@ -615,7 +626,17 @@ pp 3
             (
                 "angle 40",
                 "angle 400",
-                "t.nff:2:1: `v`: angle must lie between 0 and 180",
+                "t.nff:6:7: `v`: angle must lie between 0 and 180",
+            ),
+            (
+                "angle 40",
+                "angle 0",
+                "t.nff:6:7: `v`: angle must lie between 0 and 180, got 0",
+            ),
+            (
+                "resolution 64 48",
+                "resolution 0 0",
+                "t.nff:8:12: `v`: resolution must be at least 1x1",
             ),
             (
                 "from 0 0 5",
