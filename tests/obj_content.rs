@@ -362,3 +362,27 @@ fn material_libraries_stay_in_the_model_folder_and_are_never_quoted() {
     let red = scene.materials.iter().find(|m| m.name == "red").unwrap();
     assert_eq!(red.color, glint::math::DVec3::new(1.0, 0.0, 0.0));
 }
+
+/// An OBJ whose faces all lack area is refused like one with no faces (it
+/// rendered an empty picture with exit 0); one good face among them loads.
+#[test]
+fn an_obj_whose_faces_all_lack_area_is_refused_like_one_without_faces() {
+    let tmp = temp_dir();
+    let d = tmp.path();
+    write(
+        d,
+        "flat.obj",
+        b"v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 1 2\nf 2 2 2 2\n",
+    );
+    let e = glint::scene::load(&d.join("flat.obj"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("no face with an area"), "{e}");
+    write(
+        d,
+        "some.obj",
+        b"v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n",
+    );
+    let scene = load_file(&d.join("some.obj"));
+    assert_eq!(scene.shapes.len(), 1);
+}

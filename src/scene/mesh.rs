@@ -141,6 +141,19 @@ pub fn parse_obj(
             "the mesh has no faces (lines and points are not rendered)".into()
         });
     }
+    // All of them without area is as empty as none: refused alike (the
+    // scene would otherwise skip each one and show its background).
+    if triangles
+        .iter()
+        .all(|t| crate::shapes::Triangle::new(*t).is_none())
+    {
+        return Err(format!(
+            "the mesh has no face with an area: all {} of its triangles are degenerate \
+             (no area: corners on one line or at one point, or too far apart for \
+             their area to be a number)",
+            triangles.len()
+        ));
+    }
     let normals = match smooth {
         Some(false) => None,
         None if !any_normals => None,

@@ -179,19 +179,29 @@ mod tests {
             }
         }
         let path = Path::new("m.obj");
+        // Each beside a face of ordinary size: a model with no face that
+        // has an area is refused (below).
+        let small = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 4 5 6\n";
         for model in [
-            &b"v 1e300 0 0\nv 0 1e300 0\nv 0 0 1e300\nf 1 2 3\n"[..],
-            b"v -1e200 0 0\nv 1e200 0 0\nv 0 1e200 0\nf 1 2 3\n",
-            b"v 1e6 0 0\nv 1e6 1e-9 0\nv 1e6 0 1e-9\nf 1 2 3\n",
-            // Its only face is dropped (its area overflows): nothing to frame.
-            b"v 0 0 0\nv 1.5e308 0 0\nv 0 1.5e308 0\nf 1 2 3\n",
+            "v 1e300 0 0\nv 0 1e300 0\nv 0 0 1e300\nf 1 2 3\n",
+            "v -1e200 0 0\nv 1e200 0 0\nv 0 1e200 0\nf 1 2 3\n",
+            "v 1e6 0 0\nv 1e6 1e-9 0\nv 1e6 0 1e-9\nf 1 2 3\n",
         ] {
+            let model: &'static [u8] = format!("{model}{small}").leak().as_bytes();
             let scene = load(path, &One(model)).unwrap();
             assert!(scene.camera.eye.is_finite() && scene.camera.eye != scene.camera.lookat);
             let again = reload(&scene.source_text, path, &One(model)).unwrap();
             assert_eq!(again.camera, scene.camera);
             assert_eq!(again.lights, scene.lights);
         }
+        // A model whose only face's area overflows has no face to show:
+        // refused like one without faces.
+        let e = load(
+            path,
+            &One(b"v 0 0 0\nv 1.5e308 0 0\nv 0 1.5e308 0\nf 1 2 3\n"),
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("no face with an area"), "{e}");
         // Bounds the camera would have to stand beyond the largest double
         // to see (no triangle reaches them: a face this size overflows its
         // area and is dropped at load).
