@@ -537,3 +537,18 @@ fn flags_without_effect_are_refused() {
         assert!(stderr(&o).contains("--compare"), "{}", stderr(&o));
     }
 }
+
+/// A build without the viewer says so for `glint view`, rather than
+/// calling it an unknown subcommand (after CI's no-GUI tests, the binary
+/// in target/release is such a build).
+#[cfg(not(feature = "gui"))]
+#[test]
+fn a_build_without_the_viewer_says_so() {
+    let o = glint(&["view", "scenes/default.toml", "--screenshot", "x.png"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("built without the viewer"),
+        "{}",
+        stderr(&o)
+    );
+}

@@ -35,6 +35,14 @@ enum Command {
     /// Open a scene in the interactive viewer (the default command).
     #[cfg(feature = "gui")]
     View(view::ViewArgs),
+    /// Without the viewer compiled in, `glint view` says so (clap alone
+    /// would call it an unrecognized subcommand).
+    #[cfg(not(feature = "gui"))]
+    #[command(hide = true)]
+    View {
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<std::ffi::OsString>,
+    },
 }
 
 fn main() -> std::process::ExitCode {
@@ -56,6 +64,11 @@ fn main() -> std::process::ExitCode {
         Some(Command::View(args)) => view::run(&args),
         #[cfg(feature = "gui")]
         None => view::run(&view::ViewArgs::default()),
+        #[cfg(not(feature = "gui"))]
+        Some(Command::View { .. }) => Err(anyhow::anyhow!(
+            "this glint was built without the viewer (cargo feature `gui`, on by default): \
+             build it with `cargo build --release`, or render headless with `glint render`"
+        )),
         #[cfg(not(feature = "gui"))]
         None => {
             use clap::CommandFactory;
