@@ -41,7 +41,8 @@ pub fn choose_path(source: &SceneSource) -> Option<PathBuf> {
         Some(_) => PathBuf::from("."),
         None => super::export::export_dir(source),
     };
-    let stem = source.stem();
+    // A copy of a copy is `NAME-edited-2`, not `NAME-edited-edited`.
+    let stem = unedited_stem(&source.stem());
     let (extension, filter) = if is_nff(source) {
         ("nff", "NFF scene")
     } else {
@@ -65,6 +66,15 @@ pub fn choose_path(source: &SceneSource) -> Option<PathBuf> {
             k => folder.join(format!("{stem}-edited-{k}.{extension}")),
         })
         .find(|p| !p.exists())
+}
+
+/// `stem` without the `-edited` or `-edited-K` that "save as" added.
+fn unedited_stem(stem: &str) -> String {
+    let base = match stem.rsplit_once("-edited-") {
+        Some((base, k)) if !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()) => base,
+        _ => stem.strip_suffix("-edited").unwrap_or(stem),
+    };
+    if base.is_empty() { stem } else { base }.to_owned()
 }
 
 /// What a save did.
@@ -149,6 +159,16 @@ fn write_builtin_mesh(destination: &Path) -> anyhow::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_copy_of_a_copy_is_numbered_not_edited_twice() {
+        assert_eq!(unedited_stem("default-edited"), "default");
+        assert_eq!(unedited_stem("default-edited-12"), "default");
+        assert_eq!(unedited_stem("default"), "default");
+        assert_eq!(unedited_stem("my-edited-scene"), "my-edited-scene");
+        assert_eq!(unedited_stem("-edited"), "-edited");
+        assert_eq!(unedited_stem("a-edited-x"), "a-edited-x");
+    }
 
     #[test]
     fn the_built_in_scene_is_never_saved_into_the_working_directory() {

@@ -19,7 +19,8 @@ use crate::common::{
 
 #[derive(clap::Args)]
 pub struct RenderArgs {
-    /// Scene file (.toml or .nff); not given with --from-png.
+    /// Scene file (.toml, .nff, or a Wavefront .obj framed on its own);
+    /// not given with --from-png.
     #[arg(required_unless_present = "from_png", conflicts_with = "from_png")]
     pub scene: Option<PathBuf>,
     /// Output PNG (not needed with --trace-pixel): a `.png` file, written

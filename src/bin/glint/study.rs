@@ -101,7 +101,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
     writeln!(md, "# glint study\n")?;
     writeln!(
         md,
-        "Regenerate with `glint study {} --out {} --size {} --repeat {}`. Times are medians of {} runs on this machine \
+        "Regenerate with `glint study {} --out {} --size {} --repeat {}`. Times are {} on this machine \
          ({} threads); errors are against a reference render of the same scene.\n",
         args.scenes
             .iter()
@@ -111,7 +111,11 @@ pub fn run(args: &StudyArgs) -> Result<()> {
         args.out.display(),
         format_args!("{w}x{h}"),
         args.repeat,
-        args.repeat,
+        if args.repeat == 1 {
+            "single runs".to_string()
+        } else {
+            format!("medians of {} runs", args.repeat)
+        },
         thread_pool(args.threads)?.current_num_threads()
     )?;
     let mut summary = Vec::new();

@@ -11,7 +11,8 @@ use crate::common::{RulesArgs, Switch, parse_pixel, parse_size};
 
 #[derive(clap::Args)]
 pub struct ViewArgs {
-    /// Scene file (.toml or .nff); the built-in default scene if omitted.
+    /// Scene file (.toml, .nff, or a Wavefront .obj framed on its own); the
+    /// built-in default scene if omitted.
     pub scene: Option<PathBuf>,
     /// Save a screenshot of the whole window once the final pass is on
     /// screen, then exit.
