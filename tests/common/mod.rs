@@ -9,6 +9,9 @@ use glint::scene::Scene;
 use glint::settings::RenderSettings;
 use glint::stats::RenderCounts;
 
+#[cfg(feature = "gui")]
+pub mod viewer;
+
 pub fn repo_path(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
 }
