@@ -148,8 +148,11 @@ impl std::str::FromStr for SimdLevel {
 pub trait LaneWork {
     type Output;
     /// Runs with `N` lanes; called inside a function compiled for the
-    /// level's instruction set, so what it inlines uses it.
-    fn run<const N: usize>(self) -> Self::Output;
+    /// level's instruction set, so what it inlines uses it. `simd` compiles
+    /// further functions for the same set ([`pulp::Simd::vectorize`]):
+    /// work called from several places then exists once, not once per
+    /// place it would be inlined into.
+    fn run<S: pulp::Simd, const N: usize>(self, simd: S) -> Self::Output;
 }
 
 /// Runs `work` at `level`: with eight lanes under AVX-512, four under
@@ -179,10 +182,10 @@ impl<W: LaneWork> pulp::WithSimd for Lanes<W> {
     type Output = Option<W::Output>;
 
     #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _simd: S) -> Option<W::Output> {
+    fn with_simd<S: pulp::Simd>(self, simd: S) -> Option<W::Output> {
         match S::F64_LANES {
-            8 => Some(self.0.run::<8>()),
-            4 => Some(self.0.run::<4>()),
+            8 => Some(self.0.run::<S, 8>(simd)),
+            4 => Some(self.0.run::<S, 4>(simd)),
             _ => None,
         }
     }

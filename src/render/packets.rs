@@ -11,12 +11,12 @@
 // Lane loops index several arrays by the same lane number.
 #![allow(clippy::needless_range_loop)]
 
-use crate::accel::{ClosestHit, PacketStack, ShadowCrossings};
+use crate::accel::{ClosestHit, PacketStack, Primitives, ShadowCrossings};
 use crate::math::{Color, DVec3, Ray};
 use crate::ray_tree::{NoRecord, RayRecorder};
 use crate::shapes::{PacketHits, PreparedRay, RayPacket, ShapeHit};
 use crate::simd::{LaneWork, splat};
-use crate::stats::{Counter, NoCounts, RayCounts, RenderCounts, WorkCounts};
+use crate::stats::{Counter, NoCounts, RayCounts, RenderCounts};
 
 use super::adaptive::Signature;
 use super::integrator::ShadingPoint;
@@ -36,14 +36,13 @@ pub(super) struct PacketTile<'r, 'a> {
     pub renderer: &'r Renderer<'a>,
     pub job: TileJob<'r>,
     pub tile: Tile,
-    pub count_work: bool,
 }
 
 impl LaneWork for PacketTile<'_, '_> {
     type Output = TileOutput;
 
     #[inline(always)]
-    fn run<const N: usize>(self) -> TileOutput {
+    fn run<S: pulp::Simd, const N: usize>(self, simd: S) -> TileOutput {
         let mut out = TileOutput {
             values: Vec::with_capacity(self.tile.pixels()),
             signatures: Vec::new(),
@@ -52,24 +51,68 @@ impl LaneWork for PacketTile<'_, '_> {
         let r = self.renderer;
         let mut scratch = spare_scratch::<Scratch>();
         let mut stack = spare_scratch::<PacketScratch<N>>();
-        if self.count_work {
-            let mut work = WorkCounts::default();
-            let mut query = Query {
-                counter: &mut work,
-                scratch: &mut scratch,
-            };
-            r.fill_tile_lanes::<_, N>(self.job, self.tile, &mut query, &mut stack, &mut out);
-            out.counts.work = work;
-        } else {
-            let mut query = Query {
-                counter: &mut NoCounts,
-                scratch: &mut scratch,
-            };
-            r.fill_tile_lanes::<_, N>(self.job, self.tile, &mut query, &mut stack, &mut out);
-        }
+        let mut query = Query {
+            counter: &mut NoCounts,
+            scratch: &mut scratch,
+        };
+        r.fill_tile_lanes::<S, _, N>(simd, self.job, self.tile, &mut query, &mut stack, &mut out);
         keep_scratch(stack);
         keep_scratch(scratch);
         out
+    }
+}
+
+/// A packet's closest hits, as a function of its own per SIMD level: the
+/// walk with its shape tests inlined is the largest code glint compiles,
+/// and the four places that trace eye rays share it.
+struct ClosestWalk<'w, 'r, 'a, C, const N: usize> {
+    renderer: &'r Renderer<'a>,
+    prims: &'w Primitives<'r>,
+    packet: &'w RayPacket<N>,
+    stack: &'w mut PacketStack<N>,
+    counter: &'w mut C,
+}
+
+impl<C: Counter, const N: usize> pulp::WithSimd for ClosestWalk<'_, '_, '_, C, N> {
+    type Output = PacketHits<N>;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) -> PacketHits<N> {
+        self.renderer.octree.closest_packet(
+            self.prims,
+            self.packet,
+            splat(f64::INFINITY),
+            self.stack,
+            self.counter,
+        )
+    }
+}
+
+/// A shadow packet's walk, as a function of its own per SIMD level (see
+/// [`ClosestWalk`]).
+struct OcclusionWalk<'w, 'r, 'a, C, const N: usize> {
+    renderer: &'r Renderer<'a>,
+    prims: &'w Primitives<'r>,
+    packet: &'w RayPacket<N>,
+    lengths: &'w [f64; N],
+    found: &'w mut [ShadowCrossings; N],
+    stack: &'w mut PacketStack<N>,
+    counter: &'w mut C,
+}
+
+impl<C: Counter, const N: usize> pulp::WithSimd for OcclusionWalk<'_, '_, '_, C, N> {
+    type Output = u32;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) -> u32 {
+        self.renderer.octree.occlusion_packet(
+            self.prims,
+            self.packet,
+            *self.lengths,
+            self.found,
+            self.stack,
+            self.counter,
+        )
     }
 }
 
@@ -92,8 +135,9 @@ impl Renderer<'_> {
 
     /// [`Renderer::run_tile`]'s work, in packets of `N` eye rays.
     #[inline(always)]
-    fn fill_tile_lanes<C: Counter, const N: usize>(
+    fn fill_tile_lanes<S: pulp::Simd, C: Counter, const N: usize>(
         &self,
+        simd: S,
         job: TileJob,
         tile: Tile,
         query: &mut Query<C>,
@@ -113,6 +157,7 @@ impl Renderer<'_> {
                         let values = if signatures {
                             let mut recs = [Signature::default(); N];
                             let v = self.sample_lanes(
+                                simd,
                                 &rays[..n],
                                 query,
                                 stack,
@@ -123,7 +168,14 @@ impl Renderer<'_> {
                             v
                         } else {
                             let mut recs = [NoRecord; N];
-                            self.sample_lanes(&rays[..n], query, stack, &mut out.counts, &mut recs)
+                            self.sample_lanes(
+                                simd,
+                                &rays[..n],
+                                query,
+                                stack,
+                                &mut out.counts,
+                                &mut recs,
+                            )
                         };
                         for v in &values[..n] {
                             let mut pixel = PixelSum::default();
@@ -142,8 +194,14 @@ impl Renderer<'_> {
                         let rays: [Ray; N] =
                             std::array::from_fn(|k| self.camera.ray(i + k as u32, j, 0.0, 0.0));
                         let mut recs = [NoRecord; N];
-                        let values =
-                            self.sample_lanes(&rays[..n], query, stack, &mut out.counts, &mut recs);
+                        let values = self.sample_lanes(
+                            simd,
+                            &rays[..n],
+                            query,
+                            stack,
+                            &mut out.counts,
+                            &mut recs,
+                        );
                         out.values.extend_from_slice(&values[..n]);
                         i += n as u32;
                     }
@@ -159,7 +217,7 @@ impl Renderer<'_> {
                             if matches!(job, TileJob::Refine { .. }) {
                                 out.counts.refined_pixels += 1;
                             }
-                            self.grid_pixel_lanes(i, j, query, stack, &mut out.counts)
+                            self.grid_pixel_lanes(simd, i, j, query, stack, &mut out.counts)
                         }
                     };
                     out.values.push(value);
@@ -171,8 +229,9 @@ impl Renderer<'_> {
     /// Pixel `(i, j)` from its full grid of samples, traced `N` at a time
     /// and summed in the grid's order.
     #[inline(always)]
-    fn grid_pixel_lanes<C: Counter, const N: usize>(
+    fn grid_pixel_lanes<S: pulp::Simd, C: Counter, const N: usize>(
         &self,
+        simd: S,
         i: u32,
         j: u32,
         query: &mut Query<C>,
@@ -186,7 +245,8 @@ impl Renderer<'_> {
                 self.camera.ray(i, j, dx, dy)
             });
             let mut recs = [NoRecord; N];
-            let values = self.sample_lanes(&rays[..chunk.len()], query, stack, counts, &mut recs);
+            let values =
+                self.sample_lanes(simd, &rays[..chunk.len()], query, stack, counts, &mut recs);
             for v in &values[..chunk.len()] {
                 pixel.add(*v);
             }
@@ -197,8 +257,9 @@ impl Renderer<'_> {
     /// [`Renderer::sample`] for each of `rays` (at most `N`), with their
     /// recorders `recs`.
     #[inline(always)]
-    fn sample_lanes<C: Counter, R: RayRecorder, const N: usize>(
+    fn sample_lanes<S: pulp::Simd, C: Counter, R: RayRecorder, const N: usize>(
         &self,
+        simd: S,
         rays: &[Ray],
         query: &mut Query<C>,
         stack: &mut PacketScratch<N>,
@@ -206,9 +267,9 @@ impl Renderer<'_> {
         recs: &mut [R; N],
     ) -> [DVec3; N] {
         counts.rays.primary += rays.len() as u64;
-        let hits = self.closest_lanes::<C, N>(rays, query, stack);
+        let hits = self.closest_lanes::<S, C, N>(simd, rays, query, stack);
         let mut values = if self.settings.view.traces_shading() {
-            self.shade_lanes(rays, &hits, query, stack, &mut counts.rays, recs)
+            self.shade_lanes(simd, rays, &hits, query, stack, &mut counts.rays, recs)
         } else {
             std::array::from_fn(|k| {
                 if k < rays.len() {
@@ -230,8 +291,9 @@ impl Renderer<'_> {
     /// Each ray's closest hit: as a packet through the octree where the
     /// rays allow, one by one otherwise.
     #[inline(always)]
-    fn closest_lanes<C: Counter, const N: usize>(
+    fn closest_lanes<S: pulp::Simd, C: Counter, const N: usize>(
         &self,
+        simd: S,
         rays: &[Ray],
         query: &mut Query<C>,
         stack: &mut PacketScratch<N>,
@@ -240,13 +302,13 @@ impl Renderer<'_> {
             && let Some(packet) = RayPacket::<N>::from_rays(rays)
         {
             let prims = self.primitives();
-            let best = self.octree.closest_packet(
-                &prims,
-                &packet,
-                splat(f64::INFINITY),
-                &mut stack.walk,
-                query.counter,
-            );
+            let best = simd.vectorize(ClosestWalk {
+                renderer: self,
+                prims: &prims,
+                packet: &packet,
+                stack: &mut stack.walk,
+                counter: &mut *query.counter,
+            });
             return std::array::from_fn(|k| {
                 (k < rays.len() && best.shape[k] != PacketHits::<N>::NONE).then(|| ClosestHit {
                     shape: best.shape[k],
@@ -271,8 +333,9 @@ impl Renderer<'_> {
     /// [`Renderer::trace`] computes for each at depth 1, with the shadow
     /// rays of the hits towards each light traced together.
     #[inline(always)]
-    fn shade_lanes<C: Counter, R: RayRecorder, const N: usize>(
+    fn shade_lanes<S: pulp::Simd, C: Counter, R: RayRecorder, const N: usize>(
         &self,
+        simd: S,
         rays: &[Ray],
         hits: &[Option<ClosestHit>; N],
         query: &mut Query<C>,
@@ -310,7 +373,7 @@ impl Renderer<'_> {
                     .and_then(|at| self.toward_light(at, origins[k], light))
             });
             let passes = if self.settings.shadows {
-                self.transmittance_lanes(&origins, &toward, query, stack, ray_counts)
+                self.transmittance_lanes(simd, &origins, &toward, query, stack, ray_counts)
             } else {
                 [1.0; N]
             };
@@ -358,8 +421,9 @@ impl Renderer<'_> {
     /// scene of opaque shapes, one by one otherwise (crossings of
     /// transparent shapes are kept in order per ray).
     #[inline(always)]
-    fn transmittance_lanes<C: Counter, const N: usize>(
+    fn transmittance_lanes<S: pulp::Simd, C: Counter, const N: usize>(
         &self,
+        simd: S,
         origins: &[DVec3; N],
         toward: &[Option<(DVec3, f64, f64)>; N],
         query: &mut Query<C>,
@@ -388,14 +452,15 @@ impl Renderer<'_> {
         {
             let prims = self.primitives();
             let found = &mut stack.crossings;
-            let blocked = self.octree.occlusion_packet(
-                &prims,
-                &packet,
-                lengths,
+            let blocked = simd.vectorize(OcclusionWalk {
+                renderer: self,
+                prims: &prims,
+                packet: &packet,
+                lengths: &lengths,
                 found,
-                &mut stack.walk,
-                query.counter,
-            );
+                stack: &mut stack.walk,
+                counter: &mut *query.counter,
+            });
             for (m, &k) in lanes[..n].iter().enumerate() {
                 passes[k] = if blocked >> m & 1 == 1 {
                     0.0

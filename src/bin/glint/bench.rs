@@ -126,6 +126,8 @@ struct SceneBench {
     /// Rows traced by the brute-force comparison: every n-th (1 = all).
     compared_rows_every: u32,
     /// Render time with work counting on over off (octree on, whole image).
+    /// Counted renders trace single rays, uncounted ones packets where the
+    /// SIMD level has them: the ratio is what `--stats` costs.
     counting_overhead: f64,
     /// Rays the image needs (all kinds).
     rays_total: u64,

@@ -69,7 +69,9 @@ pub struct RenderArgs {
     /// written, its size, the render time).
     #[arg(long, short)]
     pub quiet: bool,
-    /// Print one JSON object of statistics on stdout.
+    /// Print one JSON object of statistics on stdout. Its work counts are
+    /// single rays' (packets do not count), so this render traces single
+    /// rays: the same image, in more time.
     #[arg(long)]
     pub stats: bool,
     /// Render again the image an earlier glint PNG records (its embedded
