@@ -297,7 +297,7 @@ mod tests {
         list.iter().any(|p| p == path)
     }
 
-    // Removal itself is `tests/cli_output.rs`'s: calling it here would
+    // Removal itself is `tests/integration/cli_output.rs`'s: calling it here would
     // remove other tests' files being written in parallel.
     #[test]
     fn temporary_files_are_listed_while_written_and_forgotten_after() {

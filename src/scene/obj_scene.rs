@@ -167,7 +167,7 @@ mod tests {
         assert_eq!(again.materials, scene.materials);
     }
 
-    /// Found by `tests/round_trip.rs`: models the framing overflowed wrote
+    /// Found by `tests/integration/round_trip.rs`: models the framing overflowed wrote
     /// `NaN` (or 301-digit integers) into the scene text, which then did
     /// not load again.
     #[test]

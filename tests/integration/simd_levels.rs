@@ -2,7 +2,7 @@
 //! runs renders every scene, view and setting byte-identically to the
 //! scalar path, and casts the same rays.
 
-mod common;
+use crate::common;
 
 use common::{all_scenes, load, scene_from};
 use glint::accel::Octree;

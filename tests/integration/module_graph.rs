@@ -4,7 +4,7 @@
 //! `mod.rs`'s uses of its own children, counted as one file using another.
 //! Tests (`#[cfg(test)]` to the end of a file) and comments do not count.
 
-mod common;
+use crate::common;
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;

@@ -2,7 +2,7 @@
 //! the render worker is checked directly.
 #![cfg(feature = "gui")]
 
-mod common;
+use crate::common;
 
 use std::sync::Arc;
 use std::time::Duration;
@@ -438,7 +438,8 @@ fn a_budget_preview_drops_what_it_says() {
         shadows: true,
         ..preview
     };
-    let (mut deep, scene, octree) = crate::job("scenes/glass.toml", 96, 72, AntiAliasing::Full);
+    let (mut deep, scene, octree) =
+        common::viewer::job("scenes/glass.toml", 96, 72, AntiAliasing::Full);
     deep.preview = Some(one);
     let generation = worker.submit(deep);
     assert!(worker.wait_finished(generation, WAIT));

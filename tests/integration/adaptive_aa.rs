@@ -2,7 +2,7 @@
 //! the others exactly the centre sample's, and the picture stays within a
 //! stated error of the full grid.
 
-mod common;
+use crate::common;
 
 use glint::accel::Octree;
 use glint::frame::Frame;

@@ -2,7 +2,7 @@
 //! against what the ray found, against brute force, and against the
 //! Havran counts the render itself keeps.
 
-mod common;
+use crate::common;
 
 use glint::accel::{Octree, QueryRecord, StepKind, WalkEnd};
 use glint::ray_tree::{RayNode, ShadowVerdict};

@@ -2,7 +2,7 @@
 //! OBJ's materials, the built-in scene) and the paths exports record.
 #![cfg(feature = "gui")]
 
-mod common;
+use crate::common;
 
 use common::viewer::*;
 use egui_kittest::kittest::Queryable;

@@ -1,7 +1,7 @@
 //! Where `glint render -o` writes, what it refuses, and the limits that
 //! protect the machine: run through the real binary.
 
-mod common;
+use crate::common;
 
 use std::os::unix::fs::FileTypeExt;
 use std::path::Path;

@@ -2,7 +2,7 @@
 //! shadows through glass however it is modelled, and records of scenes
 //! whose text is too large for a PNG text chunk.
 
-mod common;
+use crate::common;
 
 use common::{render_with, repo_path, scene_from};
 use glint::accel::{Octree, OctreeParams};

@@ -1,7 +1,7 @@
 //! Numerical robustness at the extremes. Every case asserts a property and
 //! reports what it measured when it fails.
 
-mod common;
+use crate::common;
 
 use common::{diff, load, render_with};
 use glint::accel::Octree;

@@ -1,7 +1,7 @@
 //! Seeing inside the render: a pixel's ray tree, per-pixel cost, the
 //! aa-need view and reproducible PNG exports.
 
-mod common;
+use crate::common;
 
 use std::process::Command;
 

@@ -1,6 +1,6 @@
 //! Every scene in `scenes/` renders, with properties checked on the images.
 
-mod common;
+use crate::common;
 
 use common::{all_scenes, diff, load, render_with};
 use glint::accel::Octree;

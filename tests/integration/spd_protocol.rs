@@ -2,7 +2,7 @@
 //! corner rays, the protocol's spawning rules on single rays, the
 //! published ray counts, and display-value shading.
 
-mod common;
+use crate::common;
 
 use common::{repo_path, scene_from};
 use glint::accel::Octree;

@@ -3,8 +3,6 @@
 //! the scene glint writes around an OBJ model opened on its own, and a
 //! scene saved with the viewer's edits.
 
-mod common;
-
 use std::path::Path;
 
 use glint::export::RenderRecord;

@@ -2,7 +2,7 @@
 //! cancellation, previews in flight, the pass cache.
 #![cfg(feature = "gui")]
 
-mod common;
+use crate::common;
 
 use std::sync::Arc;
 use std::time::Duration;

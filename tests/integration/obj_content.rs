@@ -4,7 +4,7 @@
 //! colours at known pixels, an analytic sphere, the same mesh placed by
 //! TOML.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

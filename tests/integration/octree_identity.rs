@@ -1,7 +1,7 @@
 //! The octree answers exactly what brute force answers: images are
 //! byte-identical, and random rays agree on the closest hit and on shadows.
 
-mod common;
+use crate::common;
 
 use common::{all_scenes, load, render_with};
 use glint::accel::{
