@@ -3,8 +3,8 @@
 //! timed on the same rays, and checked for accuracy on a unit sphere and a
 //! unit triangle moved 0 to 1e6 from the origin (the camera 5 units away).
 //!
-//! `cargo bench --bench precision` prints a markdown table; README
-//! ("Numerical robustness") quotes it.
+//! `cargo bench --bench precision` prints a markdown table;
+//! docs/robustness.md ("Numerical robustness") quotes it.
 
 use std::hint::black_box;
 use std::time::Instant;

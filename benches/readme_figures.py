@@ -1,21 +1,28 @@
 #!/usr/bin/env python3
-"""Measures every figure the README quotes and writes it into the README.
+"""Measures every figure the README and the user guide quote and writes it
+into the file that holds it.
 
     cargo build --release
     python3 benches/readme_figures.py              # every section (about 40 minutes on 2 cores)
     python3 benches/readme_figures.py spd-table    # one or more sections
-    python3 benches/readme_figures.py --list       # the sections and what they measure
+    python3 benches/readme_figures.py --list       # the sections, their files and what they measure
     python3 benches/readme_figures.py --reuse-sweep prediction
                                                    # format the committed sweep again
 
 Each section runs glint's own commands (target/release/glint, never built
-here) and replaces the README's text between `<!-- figures:NAME -->` and
-`<!-- /figures:NAME -->`, so no quoted figure is typed by hand. Figures
-outside those blocks are history (what a change measured when it was
-made) and say so. Needs Python 3 (standard library only); the `kernels`
-section needs valgrind, `peers` what benches/peers/run.sh installs.
+here) and replaces the text between `<!-- figures:NAME -->` and
+`<!-- /figures:NAME -->`, so no quoted figure is typed by hand. A block
+lives in exactly one of README.md and docs/**/*.md, each marker on a line
+of its own; the script finds it there (a block in none of them, or in more
+than one place, is an error, reported before anything is measured) and
+rewrites that file through a temporary file renamed into place. Figures
+outside the blocks are history (what a change measured when it was made)
+and say so; docs/notes/experiments.md keeps most of them. Needs Python 3
+(standard library only); the `kernels` section needs valgrind, `peers` what
+benches/peers/run.sh installs.
 """
 
+import glob
 import json
 import os
 import platform
@@ -31,6 +38,7 @@ import zlib
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 GLINT = os.path.join(ROOT, "target", "release", "glint")
 README = os.path.join(ROOT, "README.md")
+DOCS = os.path.join(ROOT, "docs")
 SPD = ["balls", "gears", "mount", "rings", "teapot", "tetra", "tree"]
 SPD_FILES = [f"scenes/spd/{s}.nff" for s in SPD]
 
@@ -363,7 +371,7 @@ def prediction():
     out = run([sys.executable, "benches/prediction.py"], input=sweep)
     with open(os.path.join(ROOT, "benches", "prediction.md"), "w") as f:
         f.write(out)
-    # The README quotes the summary tables; every row is in benches/prediction.md.
+    # The guide quotes the summary tables; every row is in benches/prediction.md.
     tables = out.split("\n\n", 1)[1].strip()
     return f"{tables}\n\n{made}"
 
@@ -382,7 +390,7 @@ SIMD_WORKLOADS = [
 
 
 def simd():
-    """Scalar, AVX2 and AVX-512 on the README's workloads, interleaved."""
+    """Scalar, AVX2 and AVX-512 on the guide's workloads, interleaved."""
     levels = [l for l in ("scalar", "avx2", "avx512")
               if json.loads(glint("info", "--simd", "--json"))["available"].count(l)]
     default = json.loads(glint("info", "--simd", "--json"))["level"]
@@ -464,14 +472,64 @@ SECTIONS = {
 }
 
 
-def replace_block(text, name, body):
-    pattern = re.compile(
-        rf"(<!-- figures:{re.escape(name)} -->\n)(?:.*?\n)?(<!-- /figures:{re.escape(name)} -->)",
-        re.S,
+def doc_files():
+    """The files a block may live in: README.md, then docs/**/*.md."""
+    docs = sorted(glob.glob(os.path.join(DOCS, "**", "*.md"), recursive=True))
+    return [README, *docs]
+
+
+def block_pattern(name):
+    """A whole block: its opening marker, any text, its closing marker, each
+    marker on a line of its own."""
+    return re.compile(
+        rf"(^<!-- figures:{re.escape(name)} -->\n)(?:.*?\n)?(^<!-- /figures:{re.escape(name)} -->$)",
+        re.S | re.M,
     )
+
+
+def find_block(name):
+    """The one file that holds section NAME's block; exits if no file or
+    more than one place holds it."""
+    opening = re.compile(rf"^<!-- figures:{re.escape(name)} -->$", re.M)
+    found = []
+    for path in doc_files():
+        with open(path) as f:
+            text = f.read()
+        count = len(opening.findall(text))
+        if count and not block_pattern(name).search(text):
+            sys.exit(f"readme_figures: {os.path.relpath(path, ROOT)} opens block "
+                     f"`<!-- figures:{name} -->` but never closes it")
+        found += [path] * count
+    if not found:
+        sys.exit(f"readme_figures: no block `<!-- figures:{name} -->` in README.md or docs/**/*.md")
+    if len(found) > 1:
+        places = ", ".join(os.path.relpath(p, ROOT) for p in found)
+        sys.exit(f"readme_figures: block `<!-- figures:{name} -->` is in more than one "
+                 f"place ({places}); keep exactly one")
+    return found[0]
+
+
+def replace_block(text, name, body):
+    pattern = block_pattern(name)
     if not pattern.search(text):
-        sys.exit(f"readme_figures: README.md has no block `<!-- figures:{name} -->`")
+        sys.exit(f"readme_figures: no block `<!-- figures:{name} -->`")
     return pattern.sub(lambda m: m.group(1) + body + "\n" + m.group(2), text, count=1)
+
+
+def write_block(name, body):
+    """Writes BODY into section NAME's block, in whichever file holds it,
+    through a temporary file renamed into place."""
+    path = find_block(name)
+    with open(path) as f:
+        text = f.read()
+    text = replace_block(text, name, body)
+    # Written through a temporary file, so an interrupted run leaves the
+    # file whole; each finished section is kept.
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        f.write(text)
+    os.replace(tmp, path)
+    return path
 
 
 def main():
@@ -482,28 +540,27 @@ def main():
         args.remove("--reuse-sweep")
     if args == ["--list"]:
         for name, f in SECTIONS.items():
-            print(f"{name}: {f.__doc__ or ''}".rstrip())
+            where = os.path.relpath(find_block(name), ROOT)
+            print(f"{name} ({where}): {f.__doc__ or ''}".rstrip())
         return
     unknown = [a for a in args if a not in SECTIONS]
     if unknown:
         sys.exit(f"readme_figures: unknown section(s) {', '.join(unknown)}; "
                  f"the sections: {', '.join(SECTIONS)}")
+    names = args or list(SECTIONS)
+    # Every block is found before anything is measured: a missing or
+    # doubled block fails at once, not after an hour of measuring.
+    for name in names:
+        find_block(name)
     if not os.access(GLINT, os.X_OK):
         sys.exit(f"readme_figures: {GLINT} not found: run `cargo build --release` first")
-    for name in args or list(SECTIONS):
+    for name in names:
         start = time.time()
         print(f"{name} ...", file=sys.stderr, flush=True)
         body = SECTIONS[name]()
-        with open(README) as f:
-            text = f.read()
-        text = replace_block(text, name, body)
-        # Written through a temporary file, so an interrupted run leaves the
-        # README whole; each finished section is kept.
-        tmp = README + ".tmp"
-        with open(tmp, "w") as f:
-            f.write(text)
-        os.replace(tmp, README)
-        print(f"{name}: done in {time.time() - start:.0f} s", file=sys.stderr, flush=True)
+        path = write_block(name, body)
+        print(f"{name}: done in {time.time() - start:.0f} s, written to "
+              f"{os.path.relpath(path, ROOT)}", file=sys.stderr, flush=True)
 
 
 if __name__ == "__main__":

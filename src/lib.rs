@@ -2,12 +2,12 @@
 //! viewer (feature `gui`) and the command line are layers on top of it.
 //!
 //! ```no_run
-//! let scene = glint::scene::load(std::path::Path::new("scenes/spheres.toml"))?;
+//! let scene = glint::scene::load(std::path::Path::new("scenes/sphere.toml"))?;
 //! let octree = glint::accel::Octree::build(&scene.shapes, scene.octree_params)?;
 //! let settings = scene.render_settings();
 //! let renderer = glint::render::Renderer::new(&scene, &octree, settings)?;
 //! let (frame, _counts) = renderer.render(false, None);
-//! glint::export::save_png(&frame, std::path::Path::new("spheres.png"), None)?;
+//! glint::export::save_png(&frame, std::path::Path::new("sphere.png"), None)?;
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 

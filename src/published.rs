@@ -1,7 +1,8 @@
 //! Figures others published for the SPD scenes, which glint's own are
-//! measured against: the SPD Readme's ray counts (`spd_protocol.md`) and
-//! V. Havran's best octree on each scene (Havran 1999,
-//! `havran_stats_octrees.txt`). `glint bench` prints them beside glint's,
+//! measured against: the ray counts in the README of Haines's Standard
+//! Procedural Databases and V. Havran's best octree on each scene (his
+//! 1999 octree statistics for the SPD). The figures are copied here, the
+//! documents are not in this repository. `glint bench` prints them beside glint's,
 //! and the tests check glint reproduces the counts.
 
 use serde::Serialize;
@@ -19,8 +20,8 @@ pub struct SpdCounts {
     pub eye_hits: u64,
     pub reflection: u64,
     /// Includes the rays that suffer total internal reflection, which the
-    /// protocol's own rule 9 says are not spawned (README, "The SPD
-    /// protocol").
+    /// protocol's own rule 9 says are not spawned (docs/benchmarks.md, "The
+    /// SPD protocol").
     pub refraction: u64,
     pub shadow: u64,
 }

@@ -1,8 +1,8 @@
 //! The tree of rays one eye ray spawns, for explaining a pixel. Tracing is
 //! generic over [`RayRecorder`]: [`NoRecord`] compiles every hook away,
 //! [`RayNode`] keeps the whole tree. The JSON of [`RayNode`] is the
-//! documented output of `glint render --trace-pixel` (README, "A pixel's
-//! ray tree"): add fields, never rename them.
+//! documented output of `glint render --trace-pixel` (docs/inspection.md, "A
+//! pixel's ray tree"): add fields, never rename them.
 
 use serde::Serialize;
 
@@ -97,7 +97,7 @@ pub struct RayNode {
     /// `weight * color`: what this ray adds to its parent.
     pub contribution: [f64; 3],
     /// What the ray's closest-hit query did: `walk`, `walk_end` and its
-    /// Havran counts (README, "A ray's walk through the octree").
+    /// Havran counts (docs/inspection.md, "A ray's walk through the octree").
     #[serde(flatten)]
     pub query: Option<QueryRecord>,
     pub children: Vec<RayNode>,

@@ -82,7 +82,7 @@ pub enum Protocol {
     /// each pixel), a mirror ray only from surfaces with reflectivity.
     #[default]
     Glint,
-    /// The SPD's test protocol (Haines, SPD Readme; `spd_protocol.md`):
+    /// The SPD's test protocol (Haines, the SPD's README):
     /// rays through the pixel corners, each pixel the mean of its four
     /// corners; every ray that hits a reflective or transmitting surface
     /// spawns a reflection ray; depth 5 (set by the callers that select it).
@@ -436,23 +436,42 @@ mod tests {
 
     #[test]
     fn settings_outside_the_limits_are_refused() {
+        use crate::limits::MAX_IMAGE_SIDE;
         assert!(base().check().is_ok());
-        for bad in [
+        assert!(
             RenderSettings {
+                samples: 16,
+                ..base()
+            }
+            .check()
+            .is_ok()
+        );
+        let refusal = |bad: RenderSettings| bad.check().err();
+        assert!(matches!(
+            refusal(RenderSettings {
                 samples: 8,
                 ..base()
-            },
-            RenderSettings {
-                max_depth: 0,
-                ..base()
-            },
-            RenderSettings {
-                max_depth: 65,
-                ..base()
-            },
-            RenderSettings { width: 0, ..base() },
-        ] {
-            assert!(bad.check().is_err(), "{bad:?}");
+            }),
+            Some(LimitError::Samples(8))
+        ));
+        for depth in [0, 65] {
+            assert!(matches!(
+                refusal(RenderSettings {
+                    max_depth: depth,
+                    ..base()
+                }),
+                Some(LimitError::MaxDepth(d)) if d == depth
+            ));
+        }
+        for (width, height) in [(0, 4), (MAX_IMAGE_SIDE + 1, 4)] {
+            assert!(matches!(
+                refusal(RenderSettings {
+                    width,
+                    height,
+                    ..base()
+                }),
+                Some(LimitError::ImageSize(..))
+            ));
         }
     }
 }

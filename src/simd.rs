@@ -89,7 +89,7 @@ impl SimdChoice {
     ///
     /// The default is AVX2 wherever the machine has it, AVX-512 or not:
     /// the 8-lane AVX-512 build measured slower than the 4-lane AVX2 one on
-    /// every workload of the README's "SIMD levels" table (LLVM splits most
+    /// every workload of the "SIMD levels" table in docs/benchmarks.md (LLVM splits most
     /// of its lane loops into 256- and 128-bit halves anyway, and the
     /// packets' idle lanes pay the arithmetic too), so AVX-512 runs only
     /// when forced.
@@ -98,7 +98,7 @@ impl SimdChoice {
             if SimdLevel::Avx2.is_available() {
                 let reason = if SimdLevel::Avx512.is_available() {
                     "the default: this CPU also runs AVX-512, whose 8 lanes measured slower than \
-                     AVX2's 4 (README, \"SIMD levels\"); GLINT_SIMD=avx512 forces them"
+                     AVX2's 4 (docs/benchmarks.md, \"SIMD levels\"); GLINT_SIMD=avx512 forces them"
                 } else {
                     "the best this CPU runs (it has no AVX-512)"
                 };

@@ -2,8 +2,8 @@
 //! query's Havran counts. [`WalkLog`](crate::accel::WalkLog) records them
 //! through [`Counter`](crate::stats::Counter)'s hooks; this file holds the
 //! records alone, so the counter and the octree can both name them.
-//! Their JSON is part of `glint render --trace-pixel` (README, "A ray's
-//! walk through the octree"): add fields, never rename them.
+//! Their JSON is part of `glint render --trace-pixel` (docs/inspection.md, "A
+//! ray's walk through the octree"): add fields, never rename them.
 
 use serde::Serialize;
 

@@ -1,5 +1,5 @@
 //! Wavefront MTL material libraries, mapped onto glint's Whitted/Phong
-//! material. The mapping (also a table in the README):
+//! material. The mapping (also a table in scenes/README.md):
 //!
 //! | MTL | glint |
 //! |---|---|

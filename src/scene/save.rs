@@ -1,7 +1,9 @@
-//! Writing a scene back as TOML: the viewer's "Save scene". The scene's own
-//! text is edited in place (`toml_edit`), so its comments, its order and
-//! every number nobody changed stay as they were; only values that differ
-//! from the scene as loaded are written.
+//! Writing a scene back to its file: the viewer's "Save scene". A TOML
+//! scene's own text is edited in place (`toml_edit`), so its comments, its
+//! order and every number nobody changed stay as they were; only values
+//! that differ from the scene as loaded are written. An NFF scene keeps its
+//! text too, with the numbers the viewer edits rewritten; what NFF cannot
+//! say is listed in [`SavedText::left_out`], not lost silently.
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};

@@ -138,8 +138,8 @@ fn timing_grid_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
                 row("1-sample pass", one.map_or(pending.into(), pass_time));
                 if edit.settings.samples > 1 || sixteen.is_some() {
                     // Which 16-sample pass ran: the two differ in time
-                    // far more than in the picture (README, "Adaptive
-                    // anti-aliasing").
+                    // far more than in the picture (docs/speed-and-accuracy.md,
+                    // "Adaptive anti-aliasing").
                     let adaptive =
                         sixteen.map_or(edit.settings.adaptive, |r| r.refined_pixels.is_some());
                     let label = if adaptive {

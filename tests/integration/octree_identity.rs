@@ -3,7 +3,7 @@
 
 use crate::common;
 
-use common::{all_scenes, load, render_with};
+use common::{all_scenes, render_with};
 use glint::accel::{
     Octree, OctreeParams, Primitives, ShadowCrossings, closest_brute_force, occlusion_brute_force,
 };
@@ -15,8 +15,8 @@ use proptest::prelude::*;
 #[test]
 fn octree_on_and_off_give_identical_bytes_for_every_scene() {
     for name in all_scenes() {
-        let scene = load(&name);
-        let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+        let loaded = common::loaded(&name);
+        let (scene, octree) = (&loaded.0, &loaded.1);
         // Brute force over tens of thousands of shapes is slow: keep the
         // biggest scenes small.
         let side = if scene.shapes.len() > 20_000 { 12 } else { 40 };

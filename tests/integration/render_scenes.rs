@@ -18,9 +18,9 @@ fn every_scene_renders_finite_and_non_blank() {
     let scenes = all_scenes();
     assert!(scenes.len() >= 9, "scenes found: {scenes:?}");
     for name in scenes {
-        let scene = load(&name);
-        let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
-        let (image, counts) = render_with(&scene, &octree, 48, 36, |s| s.samples = 1);
+        let loaded = common::loaded(&name);
+        let (scene, octree) = (&loaded.0, &loaded.1);
+        let (image, counts) = render_with(scene, octree, 48, 36, |s| s.samples = 1);
         assert_eq!(
             counts.nonfinite_samples, 0,
             "{name}: NaN or infinite samples"

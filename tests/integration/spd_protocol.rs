@@ -265,7 +265,7 @@ fn published_ray_counts_are_reproduced_within_ten_percent() {
         let r = counts.rays;
         assert_eq!(r.primary, 513 * 513);
         // Gears' published refraction count includes its total internal
-        // reflections (README, "The SPD protocol"): both are checked.
+        // reflections (docs/benchmarks.md, "The SPD protocol"): both are checked.
         let ours = [r.primary_hits, r.reflection, r.refraction, r.shadow];
         for (k, (&a, &b)) in ours.iter().zip(&published).enumerate() {
             let close = if b == 0 {

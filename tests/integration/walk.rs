@@ -205,7 +205,7 @@ fn the_walks_of_every_pixel_sum_to_the_renders_havran_counts() {
                 if level == SimdLevel::Scalar || !use_octree {
                     assert_eq!(summed, rendered.work, "{at}");
                 } else {
-                    // Packets: within 10% (measured: README, "A ray's walk").
+                    // Packets: within 10% (measured: docs/inspection.md, "A ray's walk").
                     for (what, walked, counted) in [
                         (
                             "steps",

@@ -13,7 +13,7 @@
 //! the eye rays alone that a camera's projected areas would weigh. What it
 //! leaves out, and so overestimates: rays stopping at their first hit, the
 //! mailbox (a shape in several leaves is tested once per ray), and rays
-//! that miss the root cell. README, "Predicting an octree's cost", says by
+//! that miss the root cell. docs/speed-and-accuracy.md, "Predicting an octree's cost", says by
 //! how much on the SPD scenes.
 
 use serde::Serialize;

@@ -114,8 +114,8 @@ struct SceneBench {
     octree_params: glint::accel::OctreeParams,
     octree_stats: OctreeStats,
     octree_on: Timing,
-    /// `octree_on` as predicted from the tree alone (README, "Predicting
-    /// an octree's cost"), at `unit_costs`.
+    /// `octree_on` as predicted from the tree alone (docs/speed-and-accuracy.md,
+    /// "Predicting an octree's cost"), at `unit_costs`.
     predicted: Prediction,
     unit_costs: UnitCosts,
     #[serde(skip_serializing_if = "Option::is_none")]

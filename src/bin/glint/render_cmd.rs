@@ -105,7 +105,7 @@ pub enum OverlayKind {
     Octree,
 }
 
-/// The `--trace-pixel` object (schema in README, "A pixel's ray tree").
+/// The `--trace-pixel` object (schema in docs/inspection.md, "A pixel's ray tree").
 #[derive(Serialize)]
 struct TraceJson<'a> {
     scene: String,

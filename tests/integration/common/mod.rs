@@ -33,6 +33,32 @@ pub fn load(rel: &str) -> Scene {
     glint::scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// A scene of `scenes/` loaded and its octree built once per test run:
+/// several tests go through every scene, and the largest take seconds to
+/// load and build. (Each caller gets the same shared copy.)
+pub fn loaded(rel: &str) -> std::sync::Arc<(Scene, Octree)> {
+    use std::collections::HashMap;
+    use std::sync::{Arc, Mutex, OnceLock};
+    type Cache = Mutex<HashMap<String, Arc<OnceLock<Arc<(Scene, Octree)>>>>>;
+    static CACHE: OnceLock<Cache> = OnceLock::new();
+    // The map's lock is held only to find the scene's slot, so two scenes
+    // load at once; one scene loads once.
+    let slot = CACHE
+        .get_or_init(Cache::default)
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .entry(rel.to_string())
+        .or_default()
+        .clone();
+    slot.get_or_init(|| {
+        let scene = load(rel);
+        let octree = Octree::build(&scene.shapes, scene.octree_params)
+            .unwrap_or_else(|e| panic!("{rel}: {e}"));
+        Arc::new((scene, octree))
+    })
+    .clone()
+}
+
 /// Every scene file under `scenes/` (TOML and NFF, recursively), sorted.
 pub fn all_scenes() -> Vec<String> {
     fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
