@@ -182,8 +182,8 @@ impl RenderSettings {
     pub fn set_anti_aliasing(&mut self, aa: AntiAliasing) {
         (self.samples, self.adaptive) = match aa {
             AntiAliasing::Off => (1, false),
-            AntiAliasing::Adaptive => (16, true),
-            AntiAliasing::Full => (16, false),
+            AntiAliasing::Adaptive => (AntiAliasing::SAMPLES, true),
+            AntiAliasing::Full => (AntiAliasing::SAMPLES, false),
         };
     }
 
@@ -271,6 +271,10 @@ pub enum AntiAliasing {
 }
 
 impl AntiAliasing {
+    /// Rays per pixel with anti-aliasing: the regular 4x4 grid. The only
+    /// other count glint renders is 1 (the pixel's centre).
+    pub const SAMPLES: u32 = 16;
+
     pub const ALL: [AntiAliasing; 3] = [
         AntiAliasing::Off,
         AntiAliasing::Adaptive,

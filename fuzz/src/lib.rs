@@ -10,7 +10,7 @@ use std::sync::OnceLock;
 
 use glint::accel::{Octree, OctreeError};
 use glint::render::Renderer;
-use glint::scene::{MeshSource, Scene};
+use glint::scene::{FileSource, Scene};
 
 /// Files by extension: the scene (`.toml`, `.nff`), the model (`.obj`) and
 /// its material library (`.mtl`). Any other path is not found, so a fuzzed
@@ -22,7 +22,7 @@ pub struct MemoryFiles<'a> {
     pub mtl: &'a [u8],
 }
 
-impl MeshSource for MemoryFiles<'_> {
+impl FileSource for MemoryFiles<'_> {
     fn read(&self, path: &Path) -> std::io::Result<Vec<u8>> {
         let extension = path
             .extension()

@@ -152,7 +152,7 @@ pub fn load_recorded_scene(record: &RenderRecord) -> Result<Scene, ExportError> 
 /// Like [`load_recorded_scene`], reading meshes from `files`.
 pub fn load_recorded_scene_with(
     record: &RenderRecord,
-    files: &dyn crate::scene::MeshSource,
+    files: &dyn crate::scene::FileSource,
 ) -> Result<Scene, ExportError> {
     let mut scene = if record.scene_path == crate::scene::builtin::NAME {
         crate::scene::builtin::load_text(&record.scene_text)?

@@ -332,6 +332,9 @@ impl Renderer<'_> {
     /// The colours of eye rays that met `hits`: what
     /// [`Renderer::trace`] computes for each at depth 1, with the shadow
     /// rays of the hits towards each light traced together.
+    // The single-ray shading's arguments, plus the instruction set's token
+    // and the packets' scratch.
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn shade_lanes<S: pulp::Simd, C: Counter, R: RayRecorder, const N: usize>(
         &self,

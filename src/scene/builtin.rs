@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use crate::scene::{MeshSource, Scene, SceneError};
+use crate::scene::{FileSource, Scene, SceneError};
 
 pub const DEFAULT_SCENE: &str = include_str!("../../scenes/default.toml");
 /// The mesh the built-in scene uses, and its file name.
@@ -13,7 +13,7 @@ pub const NAME: &str = "scenes/default.toml (built in)";
 
 struct Embedded;
 
-impl MeshSource for Embedded {
+impl FileSource for Embedded {
     fn read(&self, path: &Path) -> std::io::Result<Vec<u8>> {
         if path.file_name().is_some_and(|n| n == MESH_NAME) {
             Ok(MESH.to_vec())

@@ -10,27 +10,7 @@ use super::polygon::{DroppedPolygons, triangulate};
 use crate::material::Material;
 use crate::math::DVec3;
 
-/// Where scene and mesh files come from: the file system, or memory for
-/// scenes embedded in the binary (and for the fuzz targets).
-pub trait MeshSource {
-    fn read(&self, path: &Path) -> std::io::Result<Vec<u8>>;
-}
-
-pub struct FileSystem;
-
-impl MeshSource for FileSystem {
-    /// Regular files only: a scene naming `/dev/zero` or a pipe as its
-    /// mesh would otherwise read forever.
-    fn read(&self, path: &Path) -> std::io::Result<Vec<u8>> {
-        if !std::fs::metadata(path)?.is_file() {
-            return Err(std::io::Error::new(
-                std::io::ErrorKind::InvalidInput,
-                "not a regular file",
-            ));
-        }
-        std::fs::read(path)
-    }
-}
+use super::file_source::FileSource;
 
 /// Uniform scale, then rotation about x, y and z (degrees, in that order),
 /// then translation.
@@ -177,7 +157,7 @@ pub fn parse_obj(
 pub(super) fn read_libraries(
     libraries: &[String],
     obj_path: &Path,
-    files: &dyn MeshSource,
+    files: &dyn FileSource,
     notes: &mut Vec<String>,
 ) -> Vec<MtlEntry> {
     let folder = obj_path.parent().unwrap_or(Path::new(""));
@@ -247,7 +227,7 @@ pub(super) fn mesh_materials(
     scene: &mut Scene,
     mesh: &LoadedMesh,
     mesh_path: &Path,
-    files: &dyn MeshSource,
+    files: &dyn FileSource,
 ) -> (Vec<u32>, Option<u32>) {
     let entries = read_libraries(&mesh.libraries, mesh_path, files, &mut scene.load_notes);
     for (k, n) in mtl::not_rendered(&entries) {

@@ -3,6 +3,7 @@
 //! OBJ model also opens on its own, in a scene written around it.
 
 pub mod builtin;
+mod file_source;
 mod mesh;
 mod model;
 mod mtl;
@@ -16,7 +17,7 @@ pub mod toml_format;
 use std::path::Path;
 use std::sync::Arc;
 
-pub use mesh::{FileSystem, MeshSource};
+pub use file_source::{FileSource, FileSystem};
 pub use model::{ImageSettings, Location, MeshMaterialOrigin, Scene, SceneError};
 pub use obj::SkippedElements;
 pub use polygon::DroppedPolygons;
@@ -28,7 +29,7 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
 }
 
 /// Like [`load`], reading the scene file and its meshes from `files`.
-pub fn load_with(path: &Path, files: &dyn MeshSource) -> Result<Scene, SceneError> {
+pub fn load_with(path: &Path, files: &dyn FileSource) -> Result<Scene, SceneError> {
     if extension(path).as_deref() == Some("obj") {
         return obj_scene::load(path, files);
     }
@@ -52,7 +53,7 @@ fn extension(path: &Path) -> Option<String> {
 /// Parses scene text; `path` names it in errors, chooses the format by its
 /// extension and anchors relative mesh paths. For an `.obj` path the text
 /// is the TOML scene [`load`] wrote around it.
-pub fn load_str(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, SceneError> {
+pub fn load_str(text: &str, path: &Path, files: &dyn FileSource) -> Result<Scene, SceneError> {
     let mut scene = match extension(path).as_deref() {
         Some("toml") => toml_format::parse(text, path, files),
         Some("nff") => nff::parse(text, path),

@@ -41,7 +41,7 @@ impl Default for ImageSettings {
         Self {
             width: 640,
             height: 480,
-            samples: 16,
+            samples: crate::settings::AntiAliasing::SAMPLES,
             max_depth: 5,
             background: DVec3::ZERO,
             ambient: DVec3::splat(0.1),

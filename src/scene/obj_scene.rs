@@ -8,7 +8,7 @@ use std::path::Path;
 use crate::camera::CameraSpec;
 use crate::math::{Aabb, DVec3};
 
-use super::mesh::MeshSource;
+use super::file_source::FileSource;
 use super::model::{Scene, SceneError};
 use super::toml_format;
 
@@ -61,7 +61,7 @@ fn wrapper_text(path: &Path, camera: &CameraSpec, light: DVec3) -> String {
 }
 
 /// Loads the OBJ file `path` as a scene of its own.
-pub(super) fn load(path: &Path, files: &dyn MeshSource) -> Result<Scene, SceneError> {
+pub(super) fn load(path: &Path, files: &dyn FileSource) -> Result<Scene, SceneError> {
     // Parse once with a provisional camera, then frame the bounds.
     let provisional = CameraSpec {
         eye: DVec3::Z,
@@ -134,7 +134,7 @@ fn frame(bounds: Aabb) -> Option<(CameraSpec, DVec3)> {
 
 /// Parses `text`, the TOML an OBJ file `path` was opened with (an
 /// export's record), as that scene again.
-pub(super) fn reload(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, SceneError> {
+pub(super) fn reload(text: &str, path: &Path, files: &dyn FileSource) -> Result<Scene, SceneError> {
     toml_format::parse(text, path, files)
 }
 
@@ -143,7 +143,7 @@ mod tests {
     use super::*;
 
     struct Files;
-    impl MeshSource for Files {
+    impl FileSource for Files {
         fn read(&self, path: &Path) -> std::io::Result<Vec<u8>> {
             match path.file_name().and_then(|n| n.to_str()) {
                 Some("two.obj") => Ok(b"mtllib two.mtl\nv 10 0 0\nv 12 0 0\nv 12 2 0\nv 10 2 0\nusemtl red\nf 1 2 3\nusemtl blue\nf 1 3 4\n".to_vec()),
@@ -173,7 +173,7 @@ mod tests {
     #[test]
     fn extreme_models_are_framed_with_finite_numbers_or_refused() {
         struct One(&'static [u8]);
-        impl MeshSource for One {
+        impl FileSource for One {
             fn read(&self, _: &Path) -> std::io::Result<Vec<u8>> {
                 Ok(self.0.to_vec())
             }

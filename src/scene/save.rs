@@ -66,9 +66,56 @@ pub struct SaveRequest<'a> {
 #[derive(Clone, Debug, PartialEq)]
 pub struct SavedText {
     pub text: String,
-    /// Edits the format has no place for, each said in a few words (e.g.
-    /// "samples", "the reflectivity of f2"): they are not in `text`.
-    pub left_out: Vec<String>,
+    /// Edits the format has no place for: they are not in `text`.
+    pub left_out: Vec<LeftOut>,
+}
+
+/// An edit a scene format has no place for. The viewer keeps the file's
+/// value of a setting left out as its baseline, so the edit stays marked
+/// unsaved; `Display` says it in a few words.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum LeftOut {
+    /// Samples per pixel and adaptive anti-aliasing (NFF).
+    Samples,
+    MaxDepth,
+    Colors,
+    Sides,
+    /// The octree on or off (NFF).
+    OctreeSwitch,
+    /// A reflectivity apart from Ks: NFF has one coefficient for both.
+    Reflectivity {
+        material: String,
+    },
+    /// A material edited equal to an earlier one, which NFF reads back as
+    /// that one.
+    EqualMaterial {
+        material: String,
+        equal_to: String,
+    },
+    /// A material the TOML file has no table to write into.
+    Material {
+        name: String,
+    },
+}
+
+impl std::fmt::Display for LeftOut {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LeftOut::Samples => f.write_str("samples"),
+            LeftOut::MaxDepth => f.write_str("max depth"),
+            LeftOut::Colors => f.write_str("colours"),
+            LeftOut::Sides => f.write_str("sides"),
+            LeftOut::OctreeSwitch => f.write_str("the octree switch"),
+            LeftOut::Reflectivity { material } => {
+                write!(f, "the reflectivity of {material} (NFF uses Ks)")
+            }
+            LeftOut::EqualMaterial { material, equal_to } => write!(
+                f,
+                "{material} apart from {equal_to} (equal materials are one in NFF)"
+            ),
+            LeftOut::Material { name } => write!(f, "material {name}"),
+        }
+    }
 }
 
 /// The TOML text of `request` to be written at `destination`.
@@ -111,7 +158,7 @@ pub fn scene_toml(request: &SaveRequest, destination: &Path) -> Result<SavedText
         text: doc.to_string(),
         left_out: left_out
             .into_iter()
-            .map(|name| format!("material {name}"))
+            .map(|name| LeftOut::Material { name })
             .collect(),
     })
 }
@@ -182,20 +229,20 @@ pub fn scene_nff(request: &SaveRequest) -> Result<SavedText, SaveError> {
     if s.protocol == Protocol::Glint {
         for (what, differs) in [
             (
-                "samples",
+                LeftOut::Samples,
                 (s.samples, s.adaptive) != (im.samples, im.adaptive),
             ),
-            ("max depth", s.max_depth != im.max_depth),
-            ("colours", s.colors != im.colors),
-            ("sides", s.sides != im.sides),
+            (LeftOut::MaxDepth, s.max_depth != im.max_depth),
+            (LeftOut::Colors, s.colors != im.colors),
+            (LeftOut::Sides, s.sides != im.sides),
         ] {
             if differs {
-                left_out.push(what.to_owned());
+                left_out.push(what);
             }
         }
     }
     if s.use_octree != loaded.octree_enabled {
-        left_out.push("the octree switch".to_owned());
+        left_out.push(LeftOut::OctreeSwitch);
     }
 
     for ((place, old), new) in layout.lights.iter().zip(&loaded.lights).zip(request.lights) {
@@ -229,7 +276,9 @@ pub fn scene_nff(request: &SaveRequest) -> Result<SavedText, SaveError> {
         // NFF has one coefficient for the highlight and the mirror ray, and
         // weights the ambient term by Kd.
         if new.reflectivity != new.ks {
-            left_out.push(format!("the reflectivity of {} (NFF uses Ks)", old.name));
+            left_out.push(LeftOut::Reflectivity {
+                material: old.name.clone(),
+            });
         }
         // Every number of the material's `f` lines is written: the file's
         // own may differ from the loaded value (an opaque material's index
@@ -269,10 +318,10 @@ pub fn scene_nff(request: &SaveRequest) -> Result<SavedText, SaveError> {
             .iter()
             .find(|b| nff_key(b) == nff_key(a))
         {
-            left_out.push(format!(
-                "{} apart from {} (equal materials are one in NFF)",
-                a.name, b.name
-            ));
+            left_out.push(LeftOut::EqualMaterial {
+                material: a.name.clone(),
+                equal_to: b.name.clone(),
+            });
         }
     }
 

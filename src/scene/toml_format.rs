@@ -7,7 +7,8 @@ use std::path::Path;
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::mesh::{MeshSource, Placement, parse_obj};
+use super::file_source::FileSource;
+use super::mesh::{Placement, parse_obj};
 use super::model::{ImageSettings, Location, Scene, SceneError, line_column};
 use crate::accel::OctreeParams;
 use crate::camera::CameraSpec;
@@ -244,7 +245,7 @@ impl Context<'_> {
     }
 }
 
-pub fn parse(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, SceneError> {
+pub fn parse(text: &str, path: &Path, files: &dyn FileSource) -> Result<Scene, SceneError> {
     let mut cx = Context {
         text,
         path,
@@ -307,7 +308,7 @@ pub fn parse(text: &str, path: &Path, files: &dyn MeshSource) -> Result<Scene, S
     }
     if let Some(v) = &im.samples {
         image.samples = cx.integer(v, "image.samples", 1..17)?;
-        if image.samples != 1 && image.samples != 16 {
+        if image.samples != 1 && image.samples != AntiAliasing::SAMPLES {
             return Err(cx.error(v.span(), "image.samples", "must be 1 or 16"));
         }
     }
@@ -406,7 +407,7 @@ fn add_object(
     scene: &mut Scene,
     index: usize,
     obj: &ObjectFile,
-    files: &dyn MeshSource,
+    files: &dyn FileSource,
 ) -> Result<(), SceneError> {
     let key = |k: &str| format!("objects[{index}].{k}");
     let kind = obj.kind.get_ref().as_str();

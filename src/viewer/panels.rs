@@ -12,7 +12,7 @@ use super::worker::{PassKind, Preview, Worker};
 use crate::accel::Octree;
 use crate::color::ColorConvention;
 use crate::math::DVec3;
-use crate::settings::{Protocol, Sides, ViewMode};
+use crate::settings::{AntiAliasing, Protocol, Sides, ViewMode};
 
 /// A message shown in the status bar.
 #[derive(Clone, Debug)]
@@ -193,7 +193,11 @@ fn render_settings_ui(edit: &mut EditState, ui: &mut egui::Ui) {
         )
         .changed()
     {
-        edit.settings.samples = if anti_aliasing { 16 } else { 1 };
+        edit.settings.samples = if anti_aliasing {
+            AntiAliasing::SAMPLES
+        } else {
+            1
+        };
     }
     ui.add_enabled(
         !spd && anti_aliasing,

@@ -81,8 +81,8 @@ fn unedited_stem(stem: &str) -> String {
 pub struct Saved {
     /// The saved file, loaded back: the new "as loaded" scene.
     pub scene: Scene,
-    /// Edits the file's format could not hold, in a few words each.
-    pub left_out: Vec<String>,
+    /// Edits the file's format could not hold.
+    pub left_out: Vec<crate::scene::save::LeftOut>,
 }
 
 /// Writes `edit` to `destination` (TOML, or NFF for an NFF scene) and

@@ -200,7 +200,11 @@ impl EditState {
         match setting {
             CompareSetting::Octree => s.use_octree = !s.use_octree,
             CompareSetting::AntiAliasing => {
-                s.samples = if s.samples > 1 { 1 } else { 16 };
+                s.samples = if s.samples > 1 {
+                    1
+                } else {
+                    crate::settings::AntiAliasing::SAMPLES
+                };
             }
         }
     }

@@ -20,11 +20,11 @@ fn octree_on_and_off_give_identical_bytes_for_every_scene() {
         // Brute force over tens of thousands of shapes is slow: keep the
         // biggest scenes small.
         let side = if scene.shapes.len() > 20_000 { 12 } else { 40 };
-        let (on, c_on) = render_with(&scene, &octree, side, side, |s| {
+        let (on, c_on) = render_with(scene, octree, side, side, |s| {
             s.samples = 1;
             s.use_octree = true;
         });
-        let (off, c_off) = render_with(&scene, &octree, side, side, |s| {
+        let (off, c_off) = render_with(scene, octree, side, side, |s| {
             s.samples = 1;
             s.use_octree = false;
         });

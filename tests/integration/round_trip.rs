@@ -9,7 +9,7 @@ use glint::export::RenderRecord;
 use glint::export::{SceneEdits, load_recorded_scene_with, png_bytes, read_record_bytes};
 use glint::material::{Light, Material};
 use glint::math::DVec3;
-use glint::scene::{MeshSource, Scene};
+use glint::scene::{FileSource, Scene};
 use proptest::prelude::*;
 
 /// Scene and model files held in memory, by extension.
@@ -19,7 +19,7 @@ struct Files {
     mtl: Vec<u8>,
 }
 
-impl MeshSource for Files {
+impl FileSource for Files {
     fn read(&self, path: &Path) -> std::io::Result<Vec<u8>> {
         match path.extension().and_then(|e| e.to_str()) {
             Some("toml") => Ok(self.scene.clone().into_bytes()),

@@ -75,7 +75,7 @@ fn every_scene_renders_the_same_bytes_at_every_level() {
         // Odd sizes leave partial packets at the ends of rows.
         let side = if scene.shapes.len() > 20_000 { 19 } else { 37 };
         for samples in [1, 16] {
-            assert_levels_agree(&scene, &octree, &format!("{name} {samples} spp"), |s| {
+            assert_levels_agree(scene, octree, &format!("{name} {samples} spp"), |s| {
                 s.width = side;
                 s.height = side - 4;
                 s.samples = samples;

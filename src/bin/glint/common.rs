@@ -68,7 +68,7 @@ pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool> {
 pub fn parse_samples(s: &str) -> std::result::Result<u32, String> {
     match s {
         "1" => Ok(1),
-        "16" => Ok(16),
+        "16" => Ok(glint::settings::AntiAliasing::SAMPLES),
         _ => Err(format!("samples must be 1 or 16, got `{s}`")),
     }
 }

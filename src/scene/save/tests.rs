@@ -2,10 +2,10 @@
 
 use super::*;
 use crate::material::Light;
-use crate::scene::{MeshSource, load_str};
+use crate::scene::{FileSource, load_str};
 
 struct NoMeshes;
-impl MeshSource for NoMeshes {
+impl FileSource for NoMeshes {
     fn read(&self, _: &Path) -> std::io::Result<Vec<u8>> {
         Err(std::io::ErrorKind::NotFound.into())
     }
@@ -93,7 +93,7 @@ fn edits_are_written_and_comments_and_untouched_numbers_kept() {
 
 /// Files by name, from memory.
 struct Files(&'static [(&'static str, &'static str)]);
-impl MeshSource for Files {
+impl FileSource for Files {
     fn read(&self, path: &Path) -> std::io::Result<Vec<u8>> {
         let name = path.file_name().and_then(|n| n.to_str());
         match self.0.iter().find(|(file, _)| Some(*file) == name) {
@@ -315,7 +315,16 @@ fn an_nff_scene_is_saved_as_nff_with_its_edits_and_comments() {
     }
     assert_eq!(
         saved.left_out,
-        ["samples", "the reflectivity of f2 (NFF uses Ks)"]
+        [
+            LeftOut::Samples,
+            LeftOut::Reflectivity {
+                material: "f2".into()
+            }
+        ]
+    );
+    assert_eq!(
+        saved.left_out[1].to_string(),
+        "the reflectivity of f2 (NFF uses Ks)"
     );
     let again = load_str(text, path, &NoMeshes).unwrap();
     assert_eq!(again.camera.eye, camera.eye);
@@ -370,7 +379,14 @@ fn an_nff_material_made_transparent_gets_an_index_the_file_can_load() {
     .unwrap();
     assert_eq!(
         saved.left_out,
-        ["f2 apart from f1 (equal materials are one in NFF)"]
+        [LeftOut::EqualMaterial {
+            material: "f2".into(),
+            equal_to: "f1".into()
+        }]
+    );
+    assert_eq!(
+        saved.left_out[0].to_string(),
+        "f2 apart from f1 (equal materials are one in NFF)"
     );
 }
 

@@ -6,6 +6,7 @@ use std::sync::Arc;
 
 use super::{Discarding, GlintApp, build_octree};
 use crate::scene::Scene;
+use crate::scene::save::LeftOut;
 use crate::settings::RenderSettings;
 use crate::viewer::export;
 use crate::viewer::save;
@@ -116,13 +117,17 @@ impl GlintApp {
                 let file = reloaded.render_settings();
                 let b = &mut baseline.settings;
                 for what in &saved.left_out {
-                    match what.as_str() {
-                        "samples" => (b.samples, b.adaptive) = (file.samples, file.adaptive),
-                        "max depth" => b.max_depth = file.max_depth,
-                        "colours" => b.colors = file.colors,
-                        "sides" => b.sides = file.sides,
-                        "the octree switch" => b.use_octree = file.use_octree,
-                        _ => {}
+                    match what {
+                        LeftOut::Samples => (b.samples, b.adaptive) = (file.samples, file.adaptive),
+                        LeftOut::MaxDepth => b.max_depth = file.max_depth,
+                        LeftOut::Colors => b.colors = file.colors,
+                        LeftOut::Sides => b.sides = file.sides,
+                        LeftOut::OctreeSwitch => b.use_octree = file.use_octree,
+                        // Material edits left out are told, not undone: the
+                        // materials came back from the file above.
+                        LeftOut::Reflectivity { .. }
+                        | LeftOut::EqualMaterial { .. }
+                        | LeftOut::Material { .. } => {}
                     }
                 }
                 if saved.left_out.is_empty() {
@@ -132,7 +137,12 @@ impl GlintApp {
                         format!(
                             "saved {}, without {}: the file's format has no place for them (export a PNG to keep them)",
                             shown.display(),
-                            saved.left_out.join(", ")
+                            saved
+                                .left_out
+                                .iter()
+                                .map(LeftOut::to_string)
+                                .collect::<Vec<_>>()
+                                .join(", ")
                         ),
                         true,
                     );
