@@ -3,7 +3,7 @@
 //!
 //! ```no_run
 //! let scene = glint::scene::load(std::path::Path::new("scenes/sphere.toml"))?;
-//! let octree = glint::accel::Octree::build(&scene.shapes, scene.octree_params)?;
+//! let octree = scene.build_octree()?;
 //! let settings = scene.render_settings();
 //! let renderer = glint::render::Renderer::new(&scene, &octree, settings)?;
 //! let (frame, _counts) = renderer.render(false, None);

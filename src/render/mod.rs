@@ -33,7 +33,6 @@ pub use unit_costs::{
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::accel::Octree;
     use crate::camera::CameraSpec;
     use crate::frame::Frame;
     use crate::limits::{LimitError, MAX_IMAGE_SIDE};
@@ -76,7 +75,7 @@ mod tests {
     }
 
     fn render(scene: &Scene) -> (Frame, RenderCounts) {
-        let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+        let octree = scene.build_octree().unwrap();
         Renderer::new(scene, &octree, scene.render_settings())
             .unwrap()
             .render(false, None)
@@ -192,7 +191,7 @@ mod tests {
     fn the_renderer_refuses_settings_outside_the_limits() {
         let mut s = scene(4, 5, vec![Material::default()], DVec3::Z);
         s.push(Shape::Plane(Plane::new(DVec3::ZERO, DVec3::Z)), 0);
-        let octree = Octree::build(&s.shapes, s.octree_params).unwrap();
+        let octree = s.build_octree().unwrap();
         let base = s.render_settings();
         let with = |settings| Renderer::new(&s, &octree, settings).err();
         assert!(with(base).is_none());

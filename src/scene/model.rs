@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use crate::accel::OctreeParams;
+use crate::accel::{Octree, OctreeError, OctreeParams};
 use crate::camera::CameraSpec;
 use crate::color::ColorConvention;
 use crate::material::{Light, Material};
@@ -108,6 +108,13 @@ pub struct MeshMaterialOrigin {
 }
 
 impl Scene {
+    /// The scene's accelerator: an octree over its shapes with the scene's
+    /// own parameters (the one place a scene's octree is built; callers
+    /// that vary the parameters build with [`Octree::build`]).
+    pub fn build_octree(&self) -> Result<Octree, OctreeError> {
+        Octree::build(&self.shapes, self.octree_params)
+    }
+
     /// The settings the scene file asks for: its image size, samples,
     /// depth, colours and sides, the octree switch; glint's protocol and the
     /// shaded view. Command-line flags and the viewer override them.

@@ -777,7 +777,8 @@ impl eframe::App for GlintApp {
 
 fn build_octree(scene: &Scene) -> anyhow::Result<(Octree, f64)> {
     let start = Instant::now();
-    let octree = Octree::build(&scene.shapes, scene.octree_params)
+    let octree = scene
+        .build_octree()
         .map_err(|e| anyhow::anyhow!("{}: {e}", scene.name))?;
     Ok((octree, start.elapsed().as_secs_f64()))
 }

@@ -24,7 +24,7 @@ fn render(scene: &Scene, octree: &Octree, aa: AntiAliasing, w: u32, h: u32) -> (
 #[test]
 fn adaptive_pixels_are_either_the_full_grid_or_the_centre() {
     let scene = common::load("scenes/default.toml");
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let octree = scene.build_octree().unwrap();
     let (w, h) = (160, 120);
     let (off, _) = render(&scene, &octree, AntiAliasing::Off, w, h);
     let (full, _) = render(&scene, &octree, AntiAliasing::Full, w, h);
@@ -57,7 +57,7 @@ fn adaptive_is_within_45_db_of_the_full_grid_on_every_scene_kind() {
         "scenes/spd/balls.nff",
     ] {
         let scene = common::load(name);
-        let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+        let octree = scene.build_octree().unwrap();
         let (full, _) = render(&scene, &octree, AntiAliasing::Full, 200, 150);
         let (adaptive, refined) = render(&scene, &octree, AntiAliasing::Adaptive, 200, 150);
         let (off, _) = render(&scene, &octree, AntiAliasing::Off, 200, 150);
@@ -81,7 +81,7 @@ fn adaptive_is_within_45_db_of_the_full_grid_on_every_scene_kind() {
 #[test]
 fn adaptive_is_the_same_with_the_octree_off() {
     let scene = common::load("scenes/glass.toml");
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let octree = scene.build_octree().unwrap();
     let mut settings = scene.render_settings();
     (settings.width, settings.height) = (96, 72);
     settings.set_anti_aliasing(AntiAliasing::Adaptive);

@@ -64,7 +64,7 @@ fn transform_quadric(q: &Quadric, s: f64, t: DVec3) -> Quadric {
 }
 
 fn render_scene(scene: &Scene, w: u32, h: u32) -> (Vec<u8>, u64) {
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let octree = scene.build_octree().unwrap();
     let (img, counts) = render_with(scene, &octree, w, h, |s| s.samples = 1);
     (img, counts.nonfinite_samples)
 }
@@ -256,7 +256,7 @@ fn quadric_extremes() {
 fn total_internal_reflection_at_great_depth_stays_finite() {
     let mut scene = load("scenes/glass.toml");
     scene.image.max_depth = 64;
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let octree = scene.build_octree().unwrap();
     let (_, counts) = render_with(&scene, &octree, 48, 36, |s| s.samples = 1);
     assert_eq!(counts.nonfinite_samples, 0);
     assert!(counts.rays.refraction > 0 && counts.rays.reflection > 0);
@@ -321,7 +321,7 @@ fn extreme_cameras_and_image_shapes_see_what_the_pinhole_predicts() {
         (40.0, 10_000, 1, 2),
     ] {
         let scene = lone_sphere(distance, fov);
-        let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+        let octree = scene.build_octree().unwrap();
         let (inside, border) = sphere_pixels(w, h, fov, distance);
         assert_eq!((inside, border), (expected, 0), "the prediction itself");
         let (_, one) = render_with(&scene, &octree, w, h, |r| r.samples = 1);
@@ -331,7 +331,7 @@ fn extreme_cameras_and_image_shapes_see_what_the_pinhole_predicts() {
         assert_eq!(sixteen.rays.primary, 16 * w as u64 * h as u64);
     }
     let scene = load("scenes/sphere.toml");
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let octree = scene.build_octree().unwrap();
     // Up almost parallel to the view direction still forms a valid basis...
     let mut tilted = scene.clone();
     let view = (scene.camera.lookat - scene.camera.eye).normalize();
@@ -575,7 +575,7 @@ fn loads_cleanly_or_renders_finite(text: &str, name: &std::path::Path, what: &st
             return Outcome::Refused;
         }
     };
-    let Ok(octree) = Octree::build(&scene.shapes, scene.octree_params) else {
+    let Ok(octree) = scene.build_octree() else {
         return Outcome::NotRendered;
     };
     let mut settings = scene.render_settings();

@@ -5,7 +5,6 @@ use crate::common;
 
 use std::process::Command;
 
-use glint::accel::Octree;
 use glint::frame::Frame;
 use glint::math::DVec3;
 use glint::metrics::image_error;
@@ -152,7 +151,7 @@ fn check_sums(node: &RayNode, scene: &Scene) {
 #[test]
 fn ray_tree_of_a_glass_pixel_has_reflection_and_refraction_and_sums_to_the_pixel() {
     let scene = common::scene_from(MIRROR_AND_GLASS, "test.toml");
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let octree = scene.build_octree().unwrap();
     let s = settings(&scene, ViewMode::Shaded, true);
     let renderer = Renderer::new(&scene, &octree, s).unwrap();
     let (frame, _) = renderer.render(false, None);
@@ -196,7 +195,7 @@ fn cost_counts_one_test_per_primitive_without_the_octree_and_none_outside_it() {
     );
     let scene = common::scene_from(&text, "test.toml");
     assert_eq!(scene.shapes.len(), 2);
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let octree = scene.build_octree().unwrap();
     let corner = |use_octree| {
         let s = settings(&scene, ViewMode::Cost, use_octree);
         let (frame, _) = Renderer::new(&scene, &octree, s)
@@ -230,7 +229,7 @@ fn cost_counts_one_test_per_primitive_without_the_octree_and_none_outside_it() {
 #[test]
 fn aa_need_view_agrees_with_the_study_measure() {
     let scene = common::load("scenes/default.toml");
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let octree = scene.build_octree().unwrap();
     let mut s = settings(&scene, ViewMode::AaNeed, true);
     s.width = 96;
     s.height = 72;

@@ -126,7 +126,11 @@ fn module_graph(src: &Path) -> Graph {
                 if path.file_name().is_some_and(|n| n != "bin") {
                     pending.push(path);
                 }
-            } else if path.extension().is_some_and(|e| e == "rs") && path != src.join("lib.rs") {
+            } else if path.extension().is_some_and(|e| e == "rs")
+                && path != src.join("lib.rs")
+                // A module's unit tests in their own file are tests too.
+                && path.file_name().is_some_and(|n| n != "tests.rs")
+            {
                 files.push(path);
             }
         }
@@ -214,6 +218,78 @@ fn the_library_files_import_each_other_without_cycles() {
     );
     if let Some(cycle) = find_cycle(&graph) {
         panic!("import cycle: {}", cycle.join(" → "));
+    }
+}
+
+/// Each file's layer: 0 for a file that uses no other, else one above the
+/// highest file it uses (the graph has no cycles).
+fn layers(graph: &Graph) -> BTreeMap<String, usize> {
+    fn layer_of(graph: &Graph, node: &str, memo: &mut BTreeMap<String, usize>) -> usize {
+        if let Some(&l) = memo.get(node) {
+            return l;
+        }
+        let l = graph
+            .get(node)
+            .into_iter()
+            .flatten()
+            .map(|u| layer_of(graph, u, memo) + 1)
+            .max()
+            .unwrap_or(0);
+        memo.insert(node.to_string(), l);
+        l
+    }
+    let mut memo = BTreeMap::new();
+    for node in graph.keys() {
+        layer_of(graph, node, &mut memo);
+    }
+    memo
+}
+
+/// The drawing of the library, bottom layer first:
+/// `cargo test --release --test integration module_graph -- --nocapture`.
+#[test]
+fn the_layers_of_the_library() {
+    let graph = module_graph(&common::repo_path("src"));
+    let layers = layers(&graph);
+    let top = layers.values().copied().max().unwrap_or(0);
+    for k in 0..=top {
+        let files: Vec<&str> = layers
+            .iter()
+            .filter(|(_, l)| **l == k)
+            .map(|(f, _)| f.as_str())
+            .collect();
+        eprintln!("layer {k}: {}", files.join(", "));
+    }
+    // Every file that uses another sits above it.
+    for (file, uses) in &graph {
+        for used in uses {
+            assert!(layers[file] > layers[used], "{file} uses {used}");
+        }
+    }
+    // The core math is at the bottom and the viewer's app at the top.
+    assert_eq!(layers["math"], 0);
+    assert!(layers["viewer::app"] > layers["render::renderer"]);
+
+    // The same drawing by top-level module, where those form no cycle.
+    let mut modules = Graph::new();
+    for (file, uses) in &graph {
+        let top = |f: &str| f.split("::").next().unwrap_or(f).to_string();
+        let entry = modules.entry(top(file)).or_default();
+        entry.extend(uses.iter().map(|u| top(u)).filter(|u| *u != top(file)));
+    }
+    match find_cycle(&modules) {
+        Some(cycle) => eprintln!("top-level modules use each other: {}", cycle.join(" → ")),
+        None => {
+            let layers = self::layers(&modules);
+            for k in 0..=layers.values().copied().max().unwrap_or(0) {
+                let names: Vec<&str> = layers
+                    .iter()
+                    .filter(|(_, l)| **l == k)
+                    .map(|(m, _)| m.as_str())
+                    .collect();
+                eprintln!("module layer {k}: {}", names.join(", "));
+            }
+        }
     }
 }
 

@@ -9,7 +9,6 @@ use crate::common;
 use std::path::Path;
 
 use common::{render_with, scene_from, temp_dir};
-use glint::accel::Octree;
 use glint::scene::Scene;
 
 fn write(dir: &Path, name: &str, bytes: &[u8]) {
@@ -21,7 +20,7 @@ fn load_file(path: &Path) -> Scene {
 }
 
 fn render(scene: &Scene, w: u32, h: u32, samples: u32) -> Vec<u8> {
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let octree = scene.build_octree().unwrap();
     render_with(scene, &octree, w, h, |s| s.samples = samples).0
 }
 
@@ -292,7 +291,7 @@ fn a_face_listing_its_corners_many_times_is_one_quad() {
     write(dir.path(), "quad.obj", obj.as_bytes());
     let scene = load_file(&dir.path().join("quad.obj"));
     assert_eq!(scene.shapes.len(), 2);
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let octree = scene.build_octree().unwrap();
     assert!(octree.stats().references < 100, "{:?}", octree.stats());
 }
 

@@ -3,7 +3,6 @@
 use crate::common;
 
 use common::{all_scenes, diff, load, render_with};
-use glint::accel::Octree;
 use glint::camera::CameraSpec;
 use glint::color::linear_to_srgb;
 use glint::material::{Light, Material};
@@ -43,7 +42,7 @@ fn output_is_identical_for_any_thread_count() {
         "scenes/spd/teapot.nff",
     ] {
         let scene = load(name);
-        let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+        let octree = scene.build_octree().unwrap();
         let render = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
@@ -95,7 +94,7 @@ fn head_on_plane_matches_the_analytic_colour() {
         color: DVec3::splat(0.5),
     }];
     scene.push(Shape::Plane(Plane::new(DVec3::ZERO, DVec3::Z)), 0);
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let octree = scene.build_octree().unwrap();
     let renderer = Renderer::new(&scene, &octree, scene.render_settings()).unwrap();
     let (frame, _) = renderer.render(false, None);
     let centre = frame.pixels[4];
@@ -117,7 +116,7 @@ fn head_on_plane_matches_the_analytic_colour() {
 #[test]
 fn quadric_sphere_renders_like_the_analytic_sphere() {
     let mut scene = load("scenes/sphere.toml");
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let octree = scene.build_octree().unwrap();
     let (analytic, _) = render_with(&scene, &octree, 160, 120, |s| s.samples = 16);
     let Shape::Sphere(Sphere {
         center: c,
@@ -141,7 +140,7 @@ fn quadric_sphere_renders_like_the_analytic_sphere() {
         ],
         None,
     )));
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let octree = scene.build_octree().unwrap();
     let (quadric, _) = render_with(&scene, &octree, 160, 120, |s| s.samples = 16);
     let (over_one, largest) = diff(&analytic, &quadric, 0);
     let (over_two, _) = diff(&analytic, &quadric, 2);
@@ -158,7 +157,7 @@ fn quadric_sphere_renders_like_the_analytic_sphere() {
 fn sixteen_samples_differ_from_one_only_near_edges() {
     for name in ["scenes/sphere.toml", "scenes/quadrics.toml"] {
         let scene = load(name);
-        let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+        let octree = scene.build_octree().unwrap();
         let (w, h) = (120u32, 90u32);
         let (one, _) = render_with(&scene, &octree, w, h, |s| s.samples = 1);
         let (sixteen, _) = render_with(&scene, &octree, w, h, |s| s.samples = 16);
@@ -200,7 +199,7 @@ fn sixteen_samples_differ_from_one_only_near_edges() {
 #[test]
 fn normals_and_depth_views_are_as_documented() {
     let scene = load("scenes/sphere.toml");
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let octree = scene.build_octree().unwrap();
     let (w, h) = (81u32, 61u32);
     let (normals, _) = render_with(&scene, &octree, w, h, |s| {
         s.samples = 1;

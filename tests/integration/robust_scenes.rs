@@ -52,7 +52,7 @@ fn assert_exact_coverage(polygon: &[DVec3], eye: DVec3, size: u32) {
     let text = nff_with_polygon(eye, polygon, size);
     let scene = scene_from(&text, "polygon.nff");
     assert_eq!(scene.dropped_polygons.total(), 0, "the polygon is simple");
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let octree = scene.build_octree().unwrap();
     let mut settings = scene.render_settings();
     settings.view = ViewMode::Depth;
     let renderer = Renderer::new(&scene, &octree, settings).unwrap();
@@ -467,7 +467,7 @@ fn through(glass: &str, light_x: f64) -> f64 {
          f 1 1 1 0.1 0 1 0.9 1.5\n{glass}"
     );
     let scene = scene_from(&text, "glass.nff");
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let octree = scene.build_octree().unwrap();
     let mut settings = scene.render_settings();
     settings.max_depth = 1;
     let renderer = Renderer::new(&scene, &octree, settings).unwrap();
@@ -557,7 +557,7 @@ fn records_of_large_scenes_keep_standard_text_chunks_small() {
     let path = repo_path("scenes/spd/gears.nff");
     let scene = glint::scene::load(&path).unwrap();
     assert!(scene.source_text.len() > 1 << 20);
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let octree = scene.build_octree().unwrap();
     let mut settings = scene.render_settings();
     (settings.width, settings.height) = (8, 8);
     let renderer = Renderer::new(&scene, &octree, settings).unwrap();

@@ -92,7 +92,7 @@ fn views_octree_off_and_adaptive_agree_at_every_level() {
         "scenes/quadrics.toml",
     ] {
         let scene = load(name);
-        let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+        let octree = scene.build_octree().unwrap();
         for view in [ViewMode::Normals, ViewMode::Depth, ViewMode::AaNeed] {
             assert_levels_agree(&scene, &octree, &format!("{name} {view:?}"), |s| {
                 s.width = 33;
@@ -168,7 +168,7 @@ proptest! {
     #[test]
     fn random_soups_render_the_same_bytes_at_every_level(text in soup_strategy()) {
         let scene = scene_from(&text, "soup.toml");
-        let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+        let octree = scene.build_octree().unwrap();
         assert_levels_agree(&scene, &octree, &text, |_| {});
         assert_levels_agree(&scene, &octree, &text, |s| s.samples = 16);
     }

@@ -5,7 +5,6 @@
 use crate::common;
 
 use common::{repo_path, scene_from};
-use glint::accel::Octree;
 use glint::color::ColorConvention;
 use glint::math::DVec3;
 use glint::ray_tree::{RayKind, RayNode};
@@ -54,7 +53,7 @@ fn corner_distance(ci: u32, cj: u32, w: u32, h: u32) -> f64 {
 #[test]
 fn corner_rays_make_each_pixel_the_mean_of_its_four_corners() {
     let scene = scene_from(TILTED_PLANE, "tilted.toml");
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let octree = scene.build_octree().unwrap();
     let mut settings = spd(&scene);
     settings.view = ViewMode::Depth;
     // Three bands of corner rows, the last one partial.
@@ -125,7 +124,7 @@ impl glint::render::PassWatch for BandCollector {
 #[test]
 fn a_512_square_image_casts_513_squared_eye_rays_in_any_row_subset() {
     let scene = scene_from(TILTED_PLANE, "tilted.toml");
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let octree = scene.build_octree().unwrap();
     let mut settings = spd(&scene);
     (settings.width, settings.height) = (512, 512);
     settings.view = ViewMode::Depth;
@@ -146,7 +145,7 @@ fn nff(light: &str, body: &str) -> String {
 }
 
 fn tree_at(scene: &Scene, settings: RenderSettings, i: u32, j: u32) -> RayNode {
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let octree = scene.build_octree().unwrap();
     Renderer::new(scene, &octree, settings)
         .unwrap()
         .ray_tree(i, j)
@@ -184,7 +183,7 @@ fn a_light_behind_the_surface_gets_no_shadow_ray() {
     // A wall facing the camera, the light behind it.
     let wall = "f 1 1 1 0.8 0 1 0 0\np 4\n-9 -9 0\n9 -9 0\n9 9 0\n-9 9 0\n";
     let scene = scene_from(&nff("0 0 -5", wall), "wall.nff");
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let octree = scene.build_octree().unwrap();
     for settings in [scene.render_settings(), spd(&scene)] {
         let renderer = Renderer::new(&scene, &octree, settings).unwrap();
         let (_, counts) = renderer.render(false, None);
@@ -195,7 +194,7 @@ fn a_light_behind_the_surface_gets_no_shadow_ray() {
     }
     // With the light in front, every hit casts one.
     let lit = scene_from(&nff("0 0 5", wall), "wall.nff");
-    let octree = Octree::build(&lit.shapes, lit.octree_params).unwrap();
+    let octree = lit.build_octree().unwrap();
     let (_, counts) = Renderer::new(&lit, &octree, spd(&lit))
         .unwrap()
         .render(false, None);
@@ -231,7 +230,7 @@ fn total_internal_reflection_casts_no_refraction_ray_and_is_counted() {
     let text = "v\nfrom 0.9 -0.2 0\nat 0.9 1 0\nup 0 0 1\nangle 1\nhither 1\nresolution 1 1\n\
                 l 0 0 9\nf 1 1 1 0.1 0 1 0.9 1.5\ns 0 0 0 1\n";
     let scene = scene_from(text, "inside.nff");
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let octree = scene.build_octree().unwrap();
     let mut settings = scene.render_settings().with_protocol(Protocol::Spd);
     settings.max_depth = 2;
     let renderer = Renderer::new(&scene, &octree, settings).unwrap();
@@ -259,7 +258,7 @@ const PUBLISHED: [(&str, [u64; 4]); 7] = [
 fn published_ray_counts_are_reproduced_within_ten_percent() {
     for (name, published) in PUBLISHED {
         let scene = glint::scene::load(&repo_path(&format!("scenes/spd/{name}.nff"))).unwrap();
-        let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+        let octree = scene.build_octree().unwrap();
         let renderer = Renderer::new(&scene, &octree, spd(&scene)).unwrap();
         let (_, counts) = renderer.render(false, None);
         let r = counts.rays;
@@ -298,7 +297,7 @@ fn display_values_are_shaded_and_written_unchanged() {
                 p 4\n-9 -9 0\n9 -9 0\n9 9 0\n-9 9 0\n";
     let scene = scene_from(text, "plane.nff");
     assert_eq!(scene.image.colors, ColorConvention::Display);
-    let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+    let octree = scene.build_octree().unwrap();
     let color = DVec3::new(0.5, 0.25, 0.125);
     // One light: the ambient is sqrt(1) / 2; NFF weights it by Kd.
     let ambient = 0.5 * 0.6;

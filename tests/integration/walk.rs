@@ -4,7 +4,7 @@
 
 use crate::common;
 
-use glint::accel::{Octree, QueryRecord, StepKind, WalkEnd};
+use glint::accel::{QueryRecord, StepKind, WalkEnd};
 use glint::ray_tree::{RayNode, ShadowVerdict};
 use glint::render::Renderer;
 use glint::scene::Scene;
@@ -62,7 +62,7 @@ fn counts(q: &QueryRecord) -> WorkCounts {
 fn walks_go_front_to_back_and_find_what_the_ray_and_brute_force_find() {
     for path in SCENES {
         let scene = common::load(path);
-        let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+        let octree = scene.build_octree().unwrap();
         let on = Renderer::new(&scene, &octree, settings(&scene, true)).unwrap();
         let off = Renderer::new(&scene, &octree, settings(&scene, false)).unwrap();
         let (mut leaves, mut empties, mut blocked) = (0, 0, 0);
@@ -187,7 +187,7 @@ fn the_walks_of_every_pixel_sum_to_the_renders_havran_counts() {
     for level in levels {
         for path in SCENES {
             let scene = common::load(path);
-            let octree = Octree::build(&scene.shapes, scene.octree_params).unwrap();
+            let octree = scene.build_octree().unwrap();
             for use_octree in [true, false] {
                 let renderer = Renderer::new(&scene, &octree, settings(&scene, use_octree))
                     .unwrap()

@@ -170,8 +170,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let mut build_times = Vec::new();
         let mut octree = None;
         for _ in 0..args.repeat {
-            let (tree, s) =
-                timed(|| pool.install(|| Octree::build(&scene.shapes, scene.octree_params)));
+            let (tree, s) = timed(|| pool.install(|| scene.build_octree()));
             build_times.push(s);
             octree = Some(tree?);
         }
@@ -444,7 +443,7 @@ fn sweep(args: &BenchArgs) -> Result<()> {
         eprintln!("sweep {}", path.display());
         // Unit costs once per scene, on its own octree setting.
         let unit_costs = {
-            let octree = pool.install(|| Octree::build(&scene.shapes, scene.octree_params))?;
+            let octree = pool.install(|| scene.build_octree())?;
             UnitCosts::measure(&Renderer::new(&scene, &octree, settings)?, &octree)?
         };
         let first_row = rows.len();

@@ -288,7 +288,7 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
          (or render again a PNG that recorded an overlay, with --from-png)"
     );
     let octree = if settings.use_octree || overlay_depth.is_some() {
-        pool.install(|| Octree::build(&scene.shapes, scene.octree_params))
+        pool.install(|| scene.build_octree())
             .with_context(|| format!("cannot build the octree of {scene_name}"))?
     } else {
         Octree::build(&[], scene.octree_params)?

@@ -129,7 +129,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
         (base.width, base.height) = (w, h);
         base.use_octree = true;
         let study = Study {
-            octree: Octree::build(&scene.shapes, scene.octree_params)?,
+            octree: scene.build_octree()?,
             scene: &scene,
             repeat: args.repeat,
             pool: thread_pool(args.threads)?,

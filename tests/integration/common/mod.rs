@@ -52,7 +52,8 @@ pub fn loaded(rel: &str) -> std::sync::Arc<(Scene, Octree)> {
         .clone();
     slot.get_or_init(|| {
         let scene = load(rel);
-        let octree = Octree::build(&scene.shapes, scene.octree_params)
+        let octree = scene
+            .build_octree()
             .unwrap_or_else(|e| panic!("{rel}: {e}"));
         Arc::new((scene, octree))
     })

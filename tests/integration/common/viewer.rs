@@ -53,7 +53,7 @@ pub fn job(
     anti_aliasing: AntiAliasing,
 ) -> (Job, Arc<glint::scene::Scene>, Arc<Octree>) {
     let scene = Arc::new(super::load(scene));
-    let octree = Arc::new(Octree::build(&scene.shapes, scene.octree_params).unwrap());
+    let octree = Arc::new(scene.build_octree().unwrap());
     let mut settings = scene.render_settings();
     settings.width = width;
     settings.height = height;
