@@ -250,6 +250,9 @@ fn layers(graph: &Graph) -> BTreeMap<String, usize> {
 #[test]
 fn the_layers_of_the_library() {
     let graph = module_graph(&common::repo_path("src"));
+    if let Some(cycle) = find_cycle(&graph) {
+        panic!("no layers: import cycle {}", cycle.join(" → "));
+    }
     let layers = layers(&graph);
     let top = layers.values().copied().max().unwrap_or(0);
     for k in 0..=top {

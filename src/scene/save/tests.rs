@@ -1,8 +1,11 @@
 //! Tests of `save`.
 
+use super::mesh_paths::write_mesh_paths;
 use super::*;
 use crate::material::Light;
+use crate::math::DVec3;
 use crate::scene::{FileSource, load_str};
+use toml_edit::DocumentMut;
 
 struct NoMeshes;
 impl FileSource for NoMeshes {
