@@ -22,7 +22,7 @@ mod renderer;
 
 pub use passes::{
     FinishedPass, FinishedTile, PassInfo, PassKind, PassOptions, PassSummary, PassWatch,
-    RenderedFrame,
+    RenderedFrame, pass_settings,
 };
 pub use renderer::{RenderError, Renderer};
 pub use unit_costs::{
@@ -206,5 +206,56 @@ mod tests {
             }),
             Some(RenderError::Limit(LimitError::ImageSize(..)))
         ));
+    }
+
+    /// Each pass traces what `pass_settings` says it does: its eye rays
+    /// are its pixels times its samples (the aa-need view's grid pass
+    /// traces the 4x4 grid even at 1 sample), and the engine hands the
+    /// same settings to its watcher.
+    #[test]
+    fn each_pass_traces_what_its_settings_say() {
+        use crate::settings::ViewMode;
+        struct Seen(std::sync::Mutex<Vec<PassInfo>>);
+        impl PassWatch for Seen {
+            fn pass_started(&self, pass: &PassInfo) {
+                self.0.lock().unwrap().push(*pass);
+            }
+        }
+        let mut s = scene(6, 5, vec![Material::default()], DVec3::Z);
+        s.push(Shape::Plane(Plane::new(DVec3::ZERO, DVec3::Z)), 0);
+        let octree = s.build_octree().unwrap();
+        for (samples, view) in [
+            (1, ViewMode::Shaded),
+            (16, ViewMode::Shaded),
+            (1, ViewMode::AaNeed),
+            (16, ViewMode::Depth),
+        ] {
+            let settings = RenderSettings {
+                samples,
+                view,
+                ..s.render_settings()
+            };
+            let renderer = Renderer::new(&s, &octree, settings).unwrap();
+            let seen = Seen(Default::default());
+            let options = PassOptions {
+                count_work: false,
+                progressive: true,
+            };
+            let frame = renderer.render_frame(options, &seen).unwrap();
+            let seen = seen.0.into_inner().unwrap();
+            assert_eq!(seen.len(), frame.passes.len());
+            for (info, summary) in seen.iter().zip(&frame.passes) {
+                let expected = pass_settings(settings, info.kind);
+                assert_eq!(info.settings, expected);
+                assert_ne!(expected.view, ViewMode::AaNeed);
+                let pixels = u64::from(settings.width * settings.height);
+                assert_eq!(
+                    summary.counts.rays.primary,
+                    pixels * u64::from(expected.samples),
+                    "{samples} spp {view:?}, {:?}",
+                    info.kind
+                );
+            }
+        }
     }
 }

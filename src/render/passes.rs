@@ -16,7 +16,7 @@ use rayon::prelude::*;
 use crate::frame::{Frame, TileEncoder};
 use crate::math::DVec3;
 use crate::metrics::ImageError;
-use crate::settings::ViewMode;
+use crate::settings::{AntiAliasing, RenderSettings, ViewMode};
 use crate::stats::RenderCounts;
 
 use super::adaptive::refine_mask;
@@ -62,10 +62,38 @@ pub struct PassOptions {
     pub progressive: bool,
 }
 
+/// The settings pass `kind` of a frame of `frame` settings traces with:
+/// its own sampling (1 ray for the one-sample pass; the grid, adaptive or
+/// not, for the others; the aa-need view's grid is always the 4x4 one) and
+/// the view its pixels show (shaded, for the aa-need view's passes). What
+/// a pass renders is decided here, once; the viewer's pass cache and
+/// export records read it from [`PassInfo::settings`].
+pub fn pass_settings(frame: RenderSettings, kind: PassKind) -> RenderSettings {
+    let mut s = frame;
+    let aa_need = frame.view == ViewMode::AaNeed;
+    if aa_need {
+        s.view = ViewMode::Shaded;
+    }
+    let grid = if aa_need {
+        AntiAliasing::SAMPLES
+    } else {
+        frame.samples
+    };
+    match kind {
+        PassKind::OneSample => (s.samples, s.adaptive) = (1, false),
+        PassKind::Grid => (s.samples, s.adaptive) = (grid, false),
+        PassKind::Refine => (s.samples, s.adaptive) = (grid, true),
+        PassKind::Corners => {}
+    }
+    s
+}
+
 /// A pass as it starts: which one, of how many, over how many tiles.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PassInfo {
     pub kind: PassKind,
+    /// The settings this pass traces with ([`pass_settings`]).
+    pub settings: RenderSettings,
     /// Position in the frame's passes, from 0.
     pub index: usize,
     pub passes: usize,
@@ -250,6 +278,7 @@ impl Renderer<'_> {
         for (index, &kind) in plan.iter().enumerate() {
             let info = PassInfo {
                 kind,
+                settings: pass_settings(self.settings, kind),
                 index,
                 passes: plan.len(),
                 width: w,

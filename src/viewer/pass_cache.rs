@@ -31,32 +31,16 @@ pub(super) struct PassKey {
 
 impl PassKey {
     /// The key of pass `pass` of a job that renders `scene` through
-    /// `octree` from `camera` with `job_settings`.
+    /// `octree` from `camera` with `job_settings`: what the engine says the
+    /// pass traces ([`crate::render::pass_settings`]).
     pub(super) fn of(
         (scene, octree): (&Arc<Scene>, &Arc<Octree>),
         camera: CameraSpec,
         job_settings: RenderSettings,
         pass: crate::render::PassKind,
     ) -> Self {
-        use crate::render::PassKind as Engine;
         use crate::settings::ViewMode;
-        let mut settings = job_settings;
-        if settings.view == ViewMode::AaNeed {
-            settings.view = ViewMode::Shaded;
-        }
-        // The aa-need view's grid pass traces 16 samples, whatever the
-        // setting (as the renderer does).
-        let grid = if job_settings.view == ViewMode::AaNeed {
-            16
-        } else {
-            job_settings.samples
-        };
-        match pass {
-            Engine::OneSample => (settings.samples, settings.adaptive) = (1, false),
-            Engine::Grid => (settings.samples, settings.adaptive) = (grid, false),
-            Engine::Refine => (settings.samples, settings.adaptive) = (grid, true),
-            Engine::Corners => {}
-        }
+        let settings = crate::render::pass_settings(job_settings, pass);
         let counts_tests = matches!(settings.view, ViewMode::Cost | ViewMode::CostSteps);
         PassKey {
             scene: Arc::downgrade(scene),

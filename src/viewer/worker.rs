@@ -410,7 +410,7 @@ fn show_cached(
         return false;
     };
     let aa_need = job.settings.view == ViewMode::AaNeed;
-    let (frame, records, one_sample) = {
+    let (frame, records) = {
         let cache = shared.cache.lock().unwrap_or_else(|e| e.into_inner());
         let Some(final_pass) = cache.find(&job.pass_key(last)) else {
             return false;
@@ -431,7 +431,7 @@ fn show_cached(
         } else {
             final_pass.frame.clone()
         };
-        (frame, records, last == Engine::OneSample)
+        (frame, records)
     };
     if shared.generation.load(Ordering::SeqCst) != generation {
         return true;
@@ -450,10 +450,9 @@ fn show_cached(
             });
         }
     }
-    let mut settings = job.settings;
-    if one_sample {
-        settings.set_anti_aliasing(crate::settings::AntiAliasing::Off);
-    }
+    // What the last pass traced, as the engine says ([`Display`]'s records
+    // of rendered passes read the same).
+    let mut settings = crate::render::pass_settings(job.settings, last);
     settings.view = frame.view;
     {
         let mut b = shared.buffer.lock().unwrap_or_else(|e| e.into_inner());

@@ -81,13 +81,11 @@ impl Display<'_> {
         self.shared.buffer.lock().unwrap_or_else(|e| e.into_inner())
     }
 
-    /// The inputs of a pass, as an export records them: the pass's own
-    /// sampling (1 sample for the first pass) and the view its frame holds.
+    /// The inputs of a pass, as an export records them: the settings the
+    /// pass traced with ([`PassInfo::settings`]) and the view its frame
+    /// holds.
     fn source(&self, pass: &PassInfo, frame_view: crate::settings::ViewMode) -> FrameSource {
-        let mut settings = self.settings;
-        if pass.kind == crate::render::PassKind::OneSample {
-            settings.set_anti_aliasing(crate::settings::AntiAliasing::Off);
-        }
+        let mut settings = pass.settings;
         settings.view = frame_view;
         FrameSource {
             scene: Arc::clone(&self.job.scene),
