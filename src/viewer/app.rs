@@ -644,8 +644,9 @@ impl GlintApp {
         let passes = ready.then(|| {
             self.worker
                 .history()
-                .into_iter()
+                .iter()
                 .filter(|r| r.generation == generation)
+                .copied()
                 .collect()
         });
         if let Some(s) = &mut self.screenshot {

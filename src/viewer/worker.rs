@@ -32,10 +32,49 @@ pub use display::{DisplayBuffer, FrameSource};
 pub use job::Job;
 pub use pass_record::{PassKind, PassRecord};
 
+/// The worker's record of finished passes. Previews come at up to 60 a
+/// second while the user drags, so only the newest [`Self::MAX_PREVIEWS`]
+/// are kept (the frame budget reads the last few of each kind, the orbit
+/// benchmark those of its drag); full passes are all kept. Readers share
+/// the list ([`Arc`]); a push copies it only while one holds it.
+#[derive(Default)]
+pub(super) struct History {
+    records: Arc<Vec<PassRecord>>,
+    previews: usize,
+}
+
+impl History {
+    pub const MAX_PREVIEWS: usize = 4096;
+
+    pub(super) fn push(&mut self, record: PassRecord) {
+        let records = Arc::make_mut(&mut self.records);
+        if matches!(record.kind, PassKind::Preview(_)) {
+            self.previews += 1;
+            if self.previews > Self::MAX_PREVIEWS {
+                // Past the cap, drop the oldest preview: one scan of a few
+                // thousand records, a few times a second.
+                if let Some(k) = records
+                    .iter()
+                    .position(|r| matches!(r.kind, PassKind::Preview(_)))
+                {
+                    records.remove(k);
+                    self.previews -= 1;
+                }
+            }
+        }
+        records.push(record);
+    }
+
+    /// The record just pushed.
+    pub(super) fn last(&self) -> Option<&PassRecord> {
+        self.records.last()
+    }
+}
+
 struct Shared {
     generation: AtomicU64,
     buffer: Mutex<DisplayBuffer>,
-    history: Mutex<Vec<PassRecord>>,
+    history: Mutex<History>,
     repaint: Box<dyn Fn() + Send + Sync>,
     started: Instant,
     /// Tiles started per generation (for the cancellation test and stats).
@@ -115,7 +154,7 @@ impl Worker {
         let shared = Arc::new(Shared {
             generation: AtomicU64::new(0),
             buffer: Mutex::new(DisplayBuffer::default()),
-            history: Mutex::new(Vec::new()),
+            history: Mutex::new(History::default()),
             repaint: Box::new(repaint),
             started: Instant::now(),
             tiles_started: Mutex::new(Vec::new()),
@@ -265,11 +304,14 @@ impl Worker {
             .map_or(0, |(_, n)| *n)
     }
 
-    pub fn history(&self) -> Vec<PassRecord> {
+    /// The finished passes, oldest first (the last
+    /// 4,096 previews among them). Shared, not copied:
+    /// the UI reads it several times a frame.
+    pub fn history(&self) -> Arc<Vec<PassRecord>> {
         self.shared
             .history
             .lock()
-            .map(|h| h.clone())
+            .map(|h| Arc::clone(&h.records))
             .unwrap_or_default()
     }
 

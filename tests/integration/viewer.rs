@@ -418,7 +418,8 @@ fn a_budget_preview_drops_what_it_says() {
     assert!(worker.wait_finished(generation, WAIT));
     let passes: Vec<_> = worker
         .history()
-        .into_iter()
+        .iter()
+        .copied()
         .filter(|r| r.generation == generation)
         .collect();
     assert_eq!(passes.len(), 1, "one quick pass only");
@@ -452,7 +453,8 @@ fn a_budget_preview_drops_what_it_says() {
     assert!(counts.rays.refraction > 0, "the scene has glass");
     let r = worker
         .history()
-        .into_iter()
+        .iter()
+        .copied()
         .rfind(|r| r.generation == generation)
         .unwrap();
     assert_eq!(r.kind, PassKind::Preview(one));

@@ -51,7 +51,8 @@ fn each_plan_shows_its_passes_and_ends_on_the_cli_frame() {
         assert!(worker.wait_finished(generation, WAIT));
         let passes: Vec<_> = worker
             .history()
-            .into_iter()
+            .iter()
+            .copied()
             .filter(|r| r.generation == generation)
             .collect();
         let kinds: Vec<PassKind> = passes.iter().map(|r| r.kind).collect();
@@ -203,7 +204,8 @@ fn view_switches_show_passes_already_rendered_without_rendering() {
         assert_eq!(worker.with_buffer(|b| b.rgba.clone()), fresh(j), "{name}");
         let records: Vec<_> = worker
             .history()
-            .into_iter()
+            .iter()
+            .copied()
             .filter(|r| r.generation == g)
             .collect();
         assert!(

@@ -176,8 +176,9 @@ impl PassWatch for Display<'_> {
                 protocol: self.settings.protocol,
                 from_cache: false,
             });
-            if self.job.preview.is_none() {
-                let record = history[history.len() - 1];
+            if self.job.preview.is_none()
+                && let Some(&record) = history.last()
+            {
                 self.shared
                     .cache
                     .lock()
