@@ -5,6 +5,7 @@
 pub mod builtin;
 mod file_source;
 mod mesh;
+mod mesh_materials;
 mod model;
 mod mtl;
 pub mod nff;

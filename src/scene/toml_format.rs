@@ -642,8 +642,9 @@ fn add_object(
                 }
                 scene.push_mesh(mesh.triangles, mesh.normals, |_| material);
             } else {
-                let (slots, default) = super::mesh::mesh_materials(scene, &mesh, &mesh_path, files);
-                let origins = super::mesh::slot_names(&mesh, &slots, default);
+                let (slots, default) =
+                    super::mesh_materials::mesh_materials(scene, &mesh, &mesh_path, files);
+                let origins = super::mesh_materials::slot_names(&mesh, &slots, default);
                 if let Some(overrides) = &obj.materials {
                     for (name, m) in overrides.get_ref() {
                         let targets: Vec<u32> = origins

@@ -1,0 +1,179 @@
+//! A mesh's materials in the scene: its MTL libraries read, each material
+//! it uses added once under a name no other scene material has, and the
+//! names a scene file knows them by. Everything that names a mesh material
+//! is here; `toml_format` records where each came from and `save` writes
+//! edits back under the same names.
+
+use std::path::Path;
+
+use super::file_source::FileSource;
+use super::mesh::LoadedMesh;
+use super::model::Scene;
+use super::mtl::{self, MtlEntry};
+use crate::material::Material;
+
+/// The materials of an OBJ file's `mtllib` libraries, read through `files`
+/// relative to `obj_path`'s folder; a library that cannot be read or parsed
+/// is a note (its materials fall back to the default), not a refusal.
+pub(super) fn read_libraries(
+    libraries: &[String],
+    obj_path: &Path,
+    files: &dyn FileSource,
+    notes: &mut Vec<String>,
+) -> Vec<MtlEntry> {
+    let folder = obj_path.parent().unwrap_or(Path::new(""));
+    let mut entries = Vec::new();
+    for written in libraries {
+        // One file name with spaces, or several names.
+        let whole = inside_folder(folder, written);
+        let names: Vec<(&str, Option<std::path::PathBuf>)> =
+            if whole.as_ref().is_some_and(|p| files.read(p).is_ok()) {
+                vec![(written.as_str(), whole)]
+            } else {
+                written
+                    .split_whitespace()
+                    .map(|n| (n, inside_folder(folder, n)))
+                    .collect()
+            };
+        for (name, path) in names {
+            let Some(path) = path else {
+                notes.push(format!(
+                    "{}: `mtllib {name}` points outside the model's folder and is not read; \
+                     its materials are shown in the default material",
+                    obj_path.display()
+                ));
+                continue;
+            };
+            match files.read(&path) {
+                Ok(bytes) => match mtl::parse(&bytes) {
+                    Ok(mut found) => entries.append(&mut found),
+                    Err(e) => notes.push(format!(
+                        "{}: {e}; its materials are shown in the default material",
+                        path.display()
+                    )),
+                },
+                Err(e) => notes.push(format!(
+                    "{}: cannot read ({e}); its materials are shown in the default material",
+                    path.display()
+                )),
+            }
+        }
+    }
+    entries
+}
+
+/// A library named in an `mtllib` line, as a path in the model's folder
+/// tree: `None` for an absolute path or one whose `..` climbs out of the
+/// folder. A model is something people share, and its material libraries
+/// must not read files elsewhere on the machine that opens it.
+fn inside_folder(folder: &Path, written: &str) -> Option<std::path::PathBuf> {
+    use std::path::Component;
+    let mut depth = 0usize;
+    for component in Path::new(written).components() {
+        match component {
+            Component::Normal(_) => depth += 1,
+            Component::CurDir => {}
+            Component::ParentDir => depth = depth.checked_sub(1)?,
+            Component::RootDir | Component::Prefix(_) => return None,
+        }
+    }
+    Some(folder.join(written))
+}
+
+/// The scene's material index for each of `mesh`'s `usemtl` slots: its
+/// libraries' materials, added to the scene once each (named after the
+/// MTL, made unique), and the default material for faces with none or
+/// with a name no library defines (returned too, if any face uses it).
+pub(super) fn mesh_materials(
+    scene: &mut Scene,
+    mesh: &LoadedMesh,
+    mesh_path: &Path,
+    files: &dyn FileSource,
+) -> (Vec<u32>, Option<u32>) {
+    let entries = read_libraries(&mesh.libraries, mesh_path, files, &mut scene.load_notes);
+    for (k, n) in mtl::not_rendered(&entries) {
+        *scene.not_rendered.entry(k).or_default() += n;
+    }
+    let add = |scene: &mut Scene, material: Material| -> u32 {
+        let mut name = material.name.clone();
+        let mut k = 2;
+        while scene.materials.iter().any(|m| m.name == name) {
+            name = format!("{} ({k})", material.name);
+            k += 1;
+        }
+        scene.materials.push(Material { name, ..material });
+        scene.materials.len() as u32 - 1
+    };
+    let mut default = None;
+    let mut slots = Vec::with_capacity(mesh.material_names.len());
+    let used: Vec<bool> = {
+        let mut used = vec![false; mesh.material_names.len()];
+        for &m in &mesh.triangle_materials {
+            used[m as usize] = true;
+        }
+        used
+    };
+    for (slot, name) in mesh.material_names.iter().enumerate() {
+        let entry = (slot > 0)
+            .then(|| entries.iter().find(|e| e.name == *name))
+            .flatten();
+        let index = match entry {
+            Some(e) if used[slot] => add(scene, e.to_material(e.name.clone())),
+            _ if !used[slot] => u32::MAX,
+            _ => {
+                if slot > 0 {
+                    scene.load_notes.push(format!(
+                        "{}: no material library defines `{name}`; its faces use the default material",
+                        mesh_path.display()
+                    ));
+                }
+                *default.get_or_insert_with(|| {
+                    add(
+                        scene,
+                        Material {
+                            name: "default".into(),
+                            ..Material::default()
+                        },
+                    )
+                })
+            }
+        };
+        slots.push(index);
+    }
+    (slots, default)
+}
+
+/// Each scene material `mesh_materials` gave `mesh`, once, with the name a
+/// scene file uses for it: its MTL name, or `default` for faces with none
+/// or with a name no library defines (`default (2)` and on where the MTL
+/// names a material `default` too, so each keeps its own key).
+pub(super) fn slot_names(
+    mesh: &LoadedMesh,
+    slots: &[u32],
+    default: Option<u32>,
+) -> Vec<(u32, String)> {
+    let taken = |name: &str| {
+        slots.iter().enumerate().any(|(slot, &index)| {
+            index != u32::MAX && Some(index) != default && mesh.material_names[slot] == name
+        })
+    };
+    let mut default_name = "default".to_owned();
+    let mut k = 2;
+    while taken(&default_name) {
+        default_name = format!("default ({k})");
+        k += 1;
+    }
+    let mut names: Vec<(u32, String)> = Vec::new();
+    for (slot, &index) in slots.iter().enumerate() {
+        if index == u32::MAX || names.iter().any(|(i, _)| *i == index) {
+            continue;
+        }
+        let name = if Some(index) == default {
+            default_name.clone()
+        } else {
+            mesh.material_names[slot].clone()
+        };
+        names.push((index, name));
+    }
+    names
+}
