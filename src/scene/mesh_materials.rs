@@ -118,7 +118,18 @@ pub(super) fn mesh_materials(
             .then(|| entries.iter().find(|e| e.name == *name))
             .flatten();
         let index = match entry {
-            Some(e) if used[slot] => add(scene, e.to_material(e.name.clone())),
+            Some(e) if used[slot] => {
+                let clamped = e.clamped();
+                if !clamped.is_empty() {
+                    scene.load_notes.push(format!(
+                        "{}: material `{}`: {}, glint's limits",
+                        mesh_path.display(),
+                        e.name,
+                        clamped.join(", ")
+                    ));
+                }
+                add(scene, e.to_material(e.name.clone()))
+            }
             _ if !used[slot] => u32::MAX,
             _ => {
                 if slot > 0 {

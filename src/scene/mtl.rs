@@ -8,7 +8,7 @@
 //! | `Ns` | `shininess` |
 //! | `d`, `Tr` (= 1 - `d`) | `transparency = 1 - d` |
 //! | `Tf` | `transparency` = mean of `Tf` for refracting models (6, 7) when `d` is 1 |
-//! | `Ni` | `ior` for refracting models (6, 7); `illum 4` and `9` are glass without refraction (`ior = 1`) |
+//! | `Ni` | `ior` for refracting models (6, 7), brought within 0.01 to 100 with a load note; `illum 4` and `9` are glass without refraction (`ior = 1`) |
 //! | `illum 0, 1` | diffuse only (`ks = 0`); 0 also without ambient (`ka = 0`) |
 //! | `illum 2` | diffuse and Phong highlight |
 //! | `illum 3, 5, 8` | also mirror reflection, `reflectivity` = mean of `Ks` (5's Fresnel term is not modelled) |
@@ -205,6 +205,35 @@ impl MtlEntry {
     }
 }
 
+impl MtlEntry {
+    /// The values [`MtlEntry::to_material`] had to bring into glint's
+    /// limits, each said as `Ni 0 (used as 0.01)`: a refracting model's
+    /// `Ni` outside the index-of-refraction range, and `Ns` past the
+    /// largest shininess. A scene file refuses such values; an MTL file
+    /// comes from other tools, so the model renders and the load notes say
+    /// what changed.
+    pub fn clamped(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        let illum = self.illum.unwrap_or(2);
+        if let Some(n) = self.ni.filter(|_| matches!(illum, 6 | 7)) {
+            let (lo, hi) = (
+                *crate::limits::IOR_RANGE.start(),
+                *crate::limits::IOR_RANGE.end(),
+            );
+            if !(lo..=hi).contains(&n) {
+                out.push(format!("Ni {n} (used as {})", n.clamp(lo, hi)));
+            }
+        }
+        if let Some(n) = self.ns {
+            let hi = *crate::limits::SHININESS_RANGE.end();
+            if !(0.0..=hi).contains(&n) {
+                out.push(format!("Ns {n} (used as {})", n.clamp(0.0, hi)));
+            }
+        }
+        out
+    }
+}
+
 /// Keywords not rendered, with the number of materials that use each.
 pub(super) fn not_rendered(entries: &[MtlEntry]) -> BTreeMap<String, usize> {
     let mut out = BTreeMap::new();
@@ -328,5 +357,19 @@ bump tint_n.png
         assert!(e.message.contains("before the first `newmtl`"), "{e}");
         let e = parse(b"newmtl a\nillum 2.5\n").unwrap_err();
         assert_eq!(e.line, 2);
+    }
+
+    #[test]
+    fn values_past_the_limits_are_said() {
+        let entries =
+            parse(b"newmtl glass\nNi 0\nillum 7\nnewmtl shiny\nNs 1e9\nnewmtl fine\nNi 0\nNs 10\n")
+                .unwrap();
+        let glass = &entries[0];
+        assert_eq!(glass.clamped(), ["Ni 0 (used as 0.01)"]);
+        assert_eq!(glass.to_material("g".into()).ior, 0.01);
+        assert_eq!(entries[1].clamped().len(), 1, "{:?}", entries[1].clamped());
+        assert!(entries[1].clamped()[0].starts_with("Ns 1000000000 (used as "));
+        // Ni is not used by a model that does not refract: nothing to say.
+        assert!(entries[2].clamped().is_empty());
     }
 }

@@ -255,20 +255,7 @@ fn render_settings_ui(edit: &mut EditState, ui: &mut egui::Ui) {
                  full resolution, then 1/2, 1/4, 1/8, each complete, then with one bounce of reflection, then without reflections, then without shadows too",
             );
         });
-    ui.horizontal(|ui| {
-        ui.label("Image size");
-        ui.add(
-            DragValue::new(&mut edit.settings.width)
-                .update_while_editing(false)
-                .range(1..=crate::limits::MAX_VIEWER_SIDE),
-        );
-        ui.label("x");
-        ui.add(
-            DragValue::new(&mut edit.settings.height)
-                .update_while_editing(false)
-                .range(1..=crate::limits::MAX_VIEWER_SIDE),
-        );
-    });
+    image_size_ui(edit, ui);
     ui.horizontal_wrapped(|ui| {
         ui.label("View");
         for v in ViewMode::ALL {
@@ -469,6 +456,57 @@ fn seconds_text(s: f64) -> String {
     }
 }
 
+/// The image size fields. A side past the viewer's limit is refused with
+/// a message in place, not clamped: the field keeps the old value and says
+/// why (the command line renders larger images).
+fn image_size_ui(edit: &mut EditState, ui: &mut egui::Ui) {
+    let id = ui.scope_id().with("image size refused");
+    let (mut w, mut h) = (edit.settings.width, edit.settings.height);
+    ui.horizontal(|ui| {
+        ui.label("Image size");
+        // Wider than the limit, so a typed 9000 arrives and is refused
+        // rather than silently becoming the limit.
+        for (k, v) in [&mut w, &mut h].into_iter().enumerate() {
+            if k == 1 {
+                ui.label("x");
+            }
+            ui.add(
+                DragValue::new(v)
+                    .update_while_editing(false)
+                    .range(1..=1 << 20),
+            );
+        }
+    });
+    if (w, h) != (edit.settings.width, edit.settings.height) {
+        match size_refusal(w, h) {
+            Some(message) => {
+                ui.ctx().data_mut(|d| d.insert_temp(id, message));
+            }
+            None => {
+                (edit.settings.width, edit.settings.height) = (w, h);
+                ui.ctx().data_mut(|d| {
+                    d.remove_temp::<String>(id);
+                });
+            }
+        }
+    }
+    if let Some(message) = ui.ctx().data(|d| d.get_temp::<String>(id)) {
+        ui.colored_label(ui.visuals().warn_fg_color, message);
+    }
+}
+
+/// Why the viewer does not render a `w` x `h` image, if it does not.
+fn size_refusal(w: u32, h: u32) -> Option<String> {
+    let max = crate::limits::MAX_VIEWER_SIDE;
+    (w.max(h) > max).then(|| {
+        format!(
+            "{w}x{h} refused: the viewer renders sides up to {max} pixels \
+             (glint render -o takes up to {})",
+            crate::limits::MAX_IMAGE_SIDE
+        )
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -483,5 +521,15 @@ mod tests {
         assert_eq!(seconds_text(42.4), "42 s");
         assert_eq!(seconds_text(185.0), "3 min 5 s");
         assert_eq!(seconds_text(4320.0), "1 h 12 min");
+    }
+
+    #[test]
+    fn sizes_past_the_viewers_limit_are_refused_with_the_reason() {
+        assert_eq!(size_refusal(8192, 1), None);
+        assert_eq!(size_refusal(800, 600), None);
+        let message = size_refusal(9000, 600).unwrap();
+        assert!(message.starts_with("9000x600 refused"), "{message}");
+        assert!(message.contains("8192"), "{message}");
+        assert!(size_refusal(1, 8193).is_some());
     }
 }

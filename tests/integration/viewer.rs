@@ -674,3 +674,40 @@ fn a_rays_walk_steps_through_the_octree_in_the_panel() {
     h.run_steps(1);
     assert_eq!(h.state().walk().1, 0);
 }
+
+/// A side past the viewer's limit typed into the size field is refused
+/// where it was typed, with the reason; the size stays as it was.
+#[test]
+fn an_image_side_past_the_viewers_limit_is_refused_in_place() {
+    let mut h = harness(small_app());
+    // A width no other field shows, to find the field by its value.
+    h.state_mut().settings_mut().width = 77;
+    h.run_steps(2);
+    let generation = h.state().worker().generation();
+    h.get_by_value("77").focus();
+    h.run_steps(1);
+    // The focused field is a text edit with its text selected: typing
+    // replaces it.
+    h.event(egui::Event::Text("77000".into()));
+    h.key_press(egui::Key::Enter);
+    h.run_steps(3);
+    assert_eq!(
+        (h.state().settings().width, h.state().settings().height),
+        (77, 48),
+        "the size was not applied"
+    );
+    h.get_by_label_contains("77000x48 refused: the viewer renders sides up to 8192");
+    assert_eq!(
+        h.state().worker().generation(),
+        generation,
+        "nothing rendered"
+    );
+    // A size within the limit is taken, and the message goes.
+    h.get_by_value("77").focus();
+    h.run_steps(1);
+    h.event(egui::Event::Text("770".into()));
+    h.key_press(egui::Key::Enter);
+    h.run_steps(3);
+    assert_eq!(h.state().settings().width, 770);
+    assert!(h.query_by_label_contains("refused").is_none());
+}
