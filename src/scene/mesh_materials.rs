@@ -122,7 +122,7 @@ pub(super) fn mesh_materials(
                 let clamped = e.clamped();
                 if !clamped.is_empty() {
                     scene.load_notes.push(format!(
-                        "{}: material `{}`: {}, glint's limits",
+                        "{}: material `{}` brought within glint's limits: {}",
                         mesh_path.display(),
                         e.name,
                         clamped.join(", ")

@@ -207,7 +207,7 @@ impl MtlEntry {
 
 impl MtlEntry {
     /// The values [`MtlEntry::to_material`] had to bring into glint's
-    /// limits, each said as `Ni 0 (used as 0.01)`: a refracting model's
+    /// limits, each said as `Ni 0 used as 0.01`: a refracting model's
     /// `Ni` outside the index-of-refraction range, and `Ns` past the
     /// largest shininess. A scene file refuses such values; an MTL file
     /// comes from other tools, so the model renders and the load notes say
@@ -221,13 +221,13 @@ impl MtlEntry {
                 *crate::limits::IOR_RANGE.end(),
             );
             if !(lo..=hi).contains(&n) {
-                out.push(format!("Ni {n} (used as {})", n.clamp(lo, hi)));
+                out.push(format!("Ni {n} used as {}", n.clamp(lo, hi)));
             }
         }
         if let Some(n) = self.ns {
             let hi = *crate::limits::SHININESS_RANGE.end();
             if !(0.0..=hi).contains(&n) {
-                out.push(format!("Ns {n} (used as {})", n.clamp(0.0, hi)));
+                out.push(format!("Ns {n} used as {}", n.clamp(0.0, hi)));
             }
         }
         out
@@ -365,10 +365,10 @@ bump tint_n.png
             parse(b"newmtl glass\nNi 0\nillum 7\nnewmtl shiny\nNs 1e9\nnewmtl fine\nNi 0\nNs 10\n")
                 .unwrap();
         let glass = &entries[0];
-        assert_eq!(glass.clamped(), ["Ni 0 (used as 0.01)"]);
+        assert_eq!(glass.clamped(), ["Ni 0 used as 0.01"]);
         assert_eq!(glass.to_material("g".into()).ior, 0.01);
         assert_eq!(entries[1].clamped().len(), 1, "{:?}", entries[1].clamped());
-        assert!(entries[1].clamped()[0].starts_with("Ns 1000000000 (used as "));
+        assert!(entries[1].clamped()[0].starts_with("Ns 1000000000 used as "));
         // Ni is not used by a model that does not refract: nothing to say.
         assert!(entries[2].clamped().is_empty());
     }
