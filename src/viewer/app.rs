@@ -192,6 +192,18 @@ impl GlintApp {
             app.inspect_pixel(i, j);
         }
         if let Some((target, step)) = options.walk {
+            // A ray the pixel does not have would show nothing: refuse it
+            // with the rays there are.
+            if let Some(inspection) = &app.inspect.inspection
+                && super::walk_view::walked_ray(inspection, &target).is_none()
+            {
+                let (i, j) = inspection.pixel;
+                anyhow::bail!(
+                    "--walk {}: pixel {i},{j} has no such ray; its rays: {}",
+                    target.name(),
+                    super::walk_view::ray_names(inspection).join(", ")
+                );
+            }
             app.inspect.walk.target = Some(target);
             app.inspect.walk.shown = step.unwrap_or(usize::MAX);
         }

@@ -19,6 +19,20 @@ pub struct WalkTarget {
     pub shadow: Option<usize>,
 }
 
+impl WalkTarget {
+    /// The target as `--walk` writes it: `eye/0/shadow/1`.
+    pub fn name(&self) -> String {
+        let mut name = String::from("eye");
+        for k in &self.path {
+            name += &format!("/{k}");
+        }
+        if let Some(light) = self.shadow {
+            name += &format!("/shadow/{light}");
+        }
+        name
+    }
+}
+
 /// The inspected pixel and the tree of rays its centre ray spawned.
 #[derive(Clone, Debug)]
 pub struct Inspection {

@@ -44,6 +44,23 @@ pub struct WalkedRay<'a> {
     pub label: String,
 }
 
+/// Every ray of the inspected pixel's tree, as `--walk` names them
+/// (`eye`, `eye/0`, `eye/0/shadow/1`, ...), eye ray first.
+pub fn ray_names(inspection: &Inspection) -> Vec<String> {
+    fn visit(node: &RayNode, name: String, out: &mut Vec<String>) {
+        out.push(name.clone());
+        for s in &node.shadows {
+            out.push(format!("{name}/shadow/{}", s.light));
+        }
+        for (k, child) in node.children.iter().enumerate() {
+            visit(child, format!("{name}/{k}"), out);
+        }
+    }
+    let mut out = Vec::new();
+    visit(&inspection.tree, "eye".into(), &mut out);
+    out
+}
+
 pub fn walked_ray<'a>(inspection: &'a Inspection, target: &WalkTarget) -> Option<WalkedRay<'a>> {
     let mut node: &RayNode = &inspection.tree;
     for &k in &target.path {

@@ -711,3 +711,40 @@ fn an_image_side_past_the_viewers_limit_is_refused_in_place() {
     assert_eq!(h.state().settings().width, 770);
     assert!(h.query_by_label_contains("refused").is_none());
 }
+
+/// `--walk` to a ray the inspected pixel does not have is refused, with
+/// the rays it has; one it has is taken.
+#[test]
+fn a_walk_to_a_ray_the_pixel_lacks_is_refused_with_its_rays() {
+    let open = |walk: &str| {
+        let path: Vec<&str> = walk.split('/').skip(1).collect();
+        let mut target = glint::viewer::WalkTarget::default();
+        let mut parts = path.iter();
+        while let Some(p) = parts.next() {
+            if *p == "shadow" {
+                target.shadow = parts.next().and_then(|l| l.parse().ok());
+            } else {
+                target.path.push(p.parse().unwrap());
+            }
+        }
+        GlintApp::new(
+            glint::viewer::SceneSource::File(common::repo_path("scenes/sphere.toml")),
+            glint::viewer::ViewerOptions {
+                inspect: Some((320, 240)),
+                walk: Some((target, None)),
+                ..Default::default()
+            },
+            || {},
+        )
+    };
+    // The centre pixel sees the sphere: an eye ray and its shadow ray.
+    assert!(open("eye").is_ok());
+    assert!(open("eye/shadow/0").is_ok());
+    let error = open("eye/7/shadow/3").err().expect("refused").to_string();
+    assert!(
+        error.starts_with(
+            "--walk eye/7/shadow/3: pixel 320,240 has no such ray; its rays: eye, eye/shadow/0"
+        ),
+        "{error}"
+    );
+}
