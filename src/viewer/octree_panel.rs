@@ -195,20 +195,20 @@ pub fn octree_ui(params: OctreeParams, info: &OctreeInfo, ui: &mut egui::Ui) -> 
     });
     if let Some(Some(best)) = info.suggestion.and_then(|s| s.result()) {
         let p = best.params;
-        ui.horizontal(|ui| {
-            ui.label(format!(
-                "Suggested: depth {}, leaf size {} ({:.2} s predicted)",
-                p.max_depth,
-                p.leaf_size,
-                best.predicted_total_s()
-            ));
-            if ui
-                .add_enabled(p != params, egui::Button::new("Apply"))
-                .clicked()
-            {
-                commands.push(Command::SetOctreeParams(p));
-            }
-        });
+        // The button on a line of its own: beside the label, the fixed-width
+        // panel clipped it to a sliver.
+        ui.label(format!(
+            "Suggested: depth {}, leaf size {} ({:.2} s predicted)",
+            p.max_depth,
+            p.leaf_size,
+            best.predicted_total_s()
+        ));
+        if ui
+            .add_enabled(p != params, egui::Button::new("Apply"))
+            .clicked()
+        {
+            commands.push(Command::SetOctreeParams(p));
+        }
     } else if let Some(None) = info.suggestion.and_then(|s| s.result()) {
         ui.label("No setting of the grid fits the octree's memory budget.");
     }

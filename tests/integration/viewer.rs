@@ -748,3 +748,24 @@ fn a_walk_to_a_ray_the_pixel_lacks_is_refused_with_its_rays() {
         "{error}"
     );
 }
+
+/// The suggestion's Apply button is whole inside the left panel (it was
+/// clipped to a sliver beside its label).
+#[test]
+fn the_suggestions_apply_button_is_whole() {
+    let mut h = harness(app_for("scenes/bunny.toml", 64, 48));
+    settle(&mut h);
+    h.get_by_label("Octree parameters").click();
+    h.run_steps(3);
+    h.get_by_label("Suggest a setting").click();
+    let start = std::time::Instant::now();
+    while h.query_by_label("Apply").is_none() {
+        assert!(start.elapsed() < WAIT, "no suggestion came");
+        std::thread::sleep(Duration::from_millis(20));
+        h.run_steps(1);
+    }
+    let apply = h.get_by_label("Apply").rect();
+    assert!(apply.width() >= 30.0, "the button is {apply:?}");
+    // The left panel is 330 points wide.
+    assert!(apply.max.x <= 330.0, "the button reaches {apply:?}");
+}
