@@ -125,6 +125,17 @@ fn format_count(v: f64) -> String {
     }
 }
 
+/// A distance for the depth legend: three significant digits, in
+/// exponent form outside 0.01 to 10^6 (tiny and huge scenes alike).
+fn format_distance(v: f64) -> String {
+    if (0.01..1e6).contains(&v) {
+        let decimals = (2 - v.log10().floor() as i32).clamp(0, 4) as usize;
+        format!("{v:.decimals$}")
+    } else {
+        format!("{v:.2e}")
+    }
+}
+
 /// Encodes the tiles of a pass for display before the pass is complete:
 /// depth is normalised by the nearest distance seen so far, cost by the
 /// range seen so far (the finished pass's frame replaces them with the
@@ -306,6 +317,21 @@ impl Frame {
                     caption: format!(
                         "|1-16 spp| x{AA_NEED_GAIN}: {:.1}% px > 1/255",
                         100.0 * visible
+                    ),
+                    ramp: Ramp::Grey,
+                })
+            }
+            ViewMode::Depth => {
+                // The shade is near / distance (see `depth_shade`), so the
+                // bar runs from black at the horizon to white at the
+                // nearest point, mid-grey at twice its distance.
+                let near = nearest_depth(&self.pixels);
+                (near > 0.0 && near.is_finite()).then(|| Legend {
+                    low: "far".into(),
+                    high: format_distance(near),
+                    caption: format!(
+                        "grey = nearest / distance, mid-grey at {}",
+                        format_distance(2.0 * near)
                     ),
                     ramp: Ramp::Grey,
                 })

@@ -472,3 +472,62 @@ fn records_outside_the_limits_are_refused() {
     glint::export::save_rgb_png(&path, 1, 1, &[0, 0, 0], Some(&base)).unwrap();
     assert_eq!(glint::export::read_record(&path).unwrap(), base);
 }
+
+/// The depth view, which `--legend` lists, has a strip saying what the grey
+/// means: its white end is the nearest visible distance (a sphere of radius
+/// 1 seen from 5 away: 4), and the CLI's PNG carries it unless
+/// `--legend off`.
+#[test]
+fn the_depth_view_has_a_legend() {
+    let scene = common::scene_from(
+        r#"
+        [camera]
+        eye = [0, 0, 5]
+        lookat = [0, 0, 0]
+        up = [0, 1, 0]
+        fov = 40
+        [materials.m]
+        color = [1, 1, 1]
+        [[objects]]
+        kind = "sphere"
+        center = [0, 0, 0]
+        radius = 1
+        material = "m"
+        "#,
+        "depth.toml",
+    );
+    let octree = scene.build_octree().unwrap();
+    let mut settings = scene.render_settings();
+    (settings.width, settings.height) = (41, 41);
+    settings.view = glint::settings::ViewMode::Depth;
+    let (frame, _) = glint::render::Renderer::new(&scene, &octree, settings)
+        .unwrap()
+        .render(false, None);
+    let legend = frame.legend().expect("the depth view has a legend");
+    let near: f64 = legend.high.parse().unwrap();
+    assert!((near - 4.0).abs() < 0.01, "nearest distance {near}");
+    assert!(legend.caption.contains("8.0"), "{}", legend.caption);
+    let tmp = common::temp_dir();
+    let png = tmp.path().join("depth.png");
+    for (switch, taller) in [("on", true), ("off", false)] {
+        let out = glint()
+            .args([
+                "render",
+                common::repo_path("scenes/glass.toml").to_str().unwrap(),
+                "-o",
+            ])
+            .arg(&png)
+            .args([
+                "--width", "40", "--height", "30", "--view", "depth", "--legend", switch,
+            ])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let (w, h) = image::image_dimensions(&png).unwrap();
+        assert_eq!((w, h > 30), (40, taller), "--legend {switch}: {w}x{h}");
+    }
+}
