@@ -212,67 +212,72 @@ fn node_ui(
         ),
         None => "background".into(),
     };
-    egui::CollapsingHeader::new(
-        egui::RichText::new(format!("{kind} ray, depth {}: {what}", node.depth))
-            .color(kind_color(node.kind)),
-    )
-    .id_salt(("ray", path.clone()))
-    .default_open(node.depth <= 2)
-    .show(ui, |ui| {
-        if ui
-            .small_button("walk")
-            .on_hover_text("step through this ray's octree walk")
-            .clicked()
-        {
-            *picked = Some(WalkTarget {
-                path: path.clone(),
-                shadow: None,
-            });
-        }
-        let v = |v: [f64; 3]| format!("({:.4}, {:.4}, {:.4})", v[0], v[1], v[2]);
-        ui.label(format!("origin {}", v(node.origin)));
-        ui.label(format!("direction {}", v(node.direction)));
-        if let Some(h) = &node.hit {
-            ui.label(format!("point {}", v(h.point)));
-            ui.label(format!(
-                "normal {} ({})",
-                v(h.normal),
-                if h.entering { "entering" } else { "leaving" }
-            ));
-        }
-        for s in &node.shadows {
-            ui.horizontal(|ui| {
+    // A header of its own rather than `CollapsingHeader`, whose title never
+    // wraps: the right panel is fixed-width, and a deep hit's line is long.
+    let header = egui::RichText::new(format!("{kind} ray, depth {}: {what}", node.depth))
+        .color(kind_color(node.kind));
+    let id = ui.make_persistent_id(("ray", path.clone()));
+    egui::collapsing_header::CollapsingState::load_with_default_open(ui.ctx(), id, node.depth <= 2)
+        .show_header(ui, |ui| ui.add(egui::Label::new(header).wrap()))
+        .body(|ui| {
+            if ui
+                .small_button("walk")
+                .on_hover_text("step through this ray's octree walk")
+                .clicked()
+            {
+                *picked = Some(WalkTarget {
+                    path: path.clone(),
+                    shadow: None,
+                });
+            }
+            let v = |v: [f64; 3]| format!("({:.4}, {:.4}, {:.4})", v[0], v[1], v[2]);
+            ui.label(format!("origin {}", v(node.origin)));
+            ui.label(format!("direction {}", v(node.direction)));
+            if let Some(h) = &node.hit {
+                ui.label(format!("point {}", v(h.point)));
                 ui.label(format!(
-                    "light {}: {} (transmittance {:.3}) adds {}",
-                    s.light,
-                    s.verdict.name(),
-                    s.transmittance,
-                    rgb_text(s.color)
+                    "normal {} ({})",
+                    v(h.normal),
+                    if h.entering { "entering" } else { "leaving" }
                 ));
-                if s.query.is_some()
-                    && ui
-                        .small_button("walk")
-                        .on_hover_text("step through this shadow ray's octree walk")
-                        .clicked()
-                {
-                    *picked = Some(WalkTarget {
-                        path: path.clone(),
-                        shadow: Some(s.light),
-                    });
-                }
-            });
-        }
-        ui.label(format!("local {}", rgb_text(node.local_color)));
-        ui.label(format!(
-            "colour {} × weight {:.3} = {}",
-            rgb_text(node.color),
-            node.weight,
-            rgb_text(node.contribution)
-        ));
-        for (k, c) in node.children.iter().enumerate() {
-            path.push(k);
-            node_ui(ui, c, path, picked);
-            path.pop();
-        }
-    });
+            }
+            for s in &node.shadows {
+                // The button first: a wrapped label takes the row's width.
+                ui.horizontal(|ui| {
+                    if s.query.is_some()
+                        && ui
+                            .small_button("walk")
+                            .on_hover_text("step through this shadow ray's octree walk")
+                            .clicked()
+                    {
+                        *picked = Some(WalkTarget {
+                            path: path.clone(),
+                            shadow: Some(s.light),
+                        });
+                    }
+                    ui.add(
+                        egui::Label::new(format!(
+                            "light {}: {} (transmittance {:.3}) adds {}",
+                            s.light,
+                            s.verdict.name(),
+                            s.transmittance,
+                            rgb_text(s.color)
+                        ))
+                        .wrap(),
+                    );
+                });
+            }
+            ui.label(format!("local {}", rgb_text(node.local_color)));
+            ui.label(format!(
+                "colour {} × weight {:.3} = {}",
+                rgb_text(node.color),
+                node.weight,
+                rgb_text(node.contribution)
+            ));
+            for (k, c) in node.children.iter().enumerate() {
+                path.push(k);
+                node_ui(ui, c, path, picked);
+                path.pop();
+            }
+        });
 }

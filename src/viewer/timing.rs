@@ -19,9 +19,10 @@ pub fn timing_ui(
     inspect: &mut InspectState,
     ui: &mut egui::Ui,
 ) {
-    // Scrolls both ways: a deep ray tree's headers (which do not wrap) must
-    // not widen the fixed-width panel over the image.
-    egui::ScrollArea::both().show(ui, |ui| {
+    // Scrolls down only: every line wraps at the fixed-width panel (a line
+    // that ran off it would need a scroll bar at the bottom of a long
+    // panel, out of sight).
+    egui::ScrollArea::vertical().show(ui, |ui| {
         timing_grid_ui(edit, info, ui);
         legend_ui(info.worker, ui);
         ui.separator();

@@ -769,3 +769,36 @@ fn the_suggestions_apply_button_is_whole() {
     // The left panel is 330 points wide.
     assert!(apply.max.x <= 330.0, "the button reaches {apply:?}");
 }
+
+/// Every line of a deep ray tree fits the right panel (x 870 to 1200 in
+/// a 1200-point window): long lines wrap instead of running off its edge.
+#[test]
+fn the_ray_tree_fits_the_right_panel() {
+    let mut h = harness(app_for("scenes/glass.toml", 64, 48));
+    settle(&mut h);
+    h.state_mut().inspect_pixel(32, 24);
+    h.run_steps(3);
+    let tree = h.state().inspection().unwrap().tree.clone();
+    assert!(!tree.children.is_empty(), "the pixel sees glass");
+    let lines: Vec<(String, egui::Rect)> = h
+        .get_all_by(|n| {
+            n.label().or(n.value()).is_some_and(|t| {
+                t.contains("ray, depth") || t.starts_with("light ") || t.starts_with("colour (")
+            })
+        })
+        .map(|n| (format!("{n:?}").chars().take(120).collect(), n.rect()))
+        .collect();
+    assert!(lines.len() > 4, "{lines:?}");
+    assert!(
+        h.query_all_by(|n| n.bounding_box().is_some_and(|r| r.x1 > 1200.0))
+            .next()
+            .is_none(),
+        "nothing in the window runs past its right edge"
+    );
+    for (text, rect) in lines {
+        assert!(
+            rect.min.x >= 865.0 && rect.max.x <= 1200.0,
+            "{text:?} at {rect:?}"
+        );
+    }
+}
