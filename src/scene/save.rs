@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 use toml_edit::{Item, TableLike, Value};
 
 use super::Scene;
+use crate::accel::OctreeParams;
 use crate::camera::CameraSpec;
 use crate::material::{Light, Material};
 use crate::settings::RenderSettings;
@@ -64,6 +65,8 @@ pub struct SaveRequest<'a> {
     /// Under the SPD protocol the image settings are the protocol's, not
     /// the scene's, so only the octree switch is written.
     pub settings: &'a RenderSettings,
+    /// The octree's parameters as edited (TOML's `[octree]` table).
+    pub octree: &'a OctreeParams,
     pub mesh_paths: MeshPaths,
 }
 
@@ -87,6 +90,8 @@ pub enum LeftOut {
     Sides,
     /// The octree on or off (NFF).
     OctreeSwitch,
+    /// The octree's depth, leaf size and other parameters (NFF).
+    OctreeParams,
     /// A reflectivity apart from Ks: NFF has one coefficient for both.
     Reflectivity {
         material: String,
@@ -111,6 +116,7 @@ impl std::fmt::Display for LeftOut {
             LeftOut::Colors => f.write_str("colours"),
             LeftOut::Sides => f.write_str("sides"),
             LeftOut::OctreeSwitch => f.write_str("the octree switch"),
+            LeftOut::OctreeParams => f.write_str("the octree parameters"),
             LeftOut::Reflectivity { material } => {
                 write!(f, "the reflectivity of {material} (NFF uses Ks)")
             }

@@ -70,6 +70,7 @@ struct OctreeFile {
     leaf_size: Option<Spanned<i64>>,
     max_duplication: Option<Spanned<i64>>,
     memory_budget_mib: Option<Spanned<i64>>,
+    cost_driven: Option<bool>,
 }
 
 #[derive(Deserialize)]
@@ -392,6 +393,9 @@ pub fn parse(text: &str, path: &Path, files: &dyn FileSource) -> Result<Scene, S
 
     let mut scene = Scene::empty(path.display().to_string(), camera, image);
     scene.octree_enabled = file.octree.enabled.unwrap_or(true);
+    if let Some(v) = file.octree.cost_driven {
+        octree_params.cost_driven = v;
+    }
     scene.octree_params = octree_params;
     cx.defined_materials = materials.len();
     scene.materials = materials;

@@ -4,11 +4,13 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::time::Instant;
 
 use egui::{Color32, Sense, TextureHandle, TextureOptions};
 
+mod octree_tuning;
 mod scene_files;
+
+use octree_tuning::build_octree;
 
 use super::command::Command;
 use super::compare::{Compare, CompareMode, DiffStats};
@@ -25,7 +27,7 @@ use super::worker::{Job, Preview, Worker};
 use super::{budget, export, input, panels, timing};
 use crate::accel::{Octree, OctreeParams};
 use crate::camera::CameraSpec;
-use crate::render::{Renderer, UnitCosts};
+use crate::render::UnitCosts;
 use crate::scene::Scene;
 use crate::settings::{AntiAliasing, Overrides, RenderSettings};
 
@@ -74,6 +76,8 @@ struct RenderInputs {
     camera: CameraSpec,
     settings: RenderSettings,
     scene_version: u64,
+    /// The octree's parameters: a new tree renders again (for its times).
+    octree: OctreeParams,
     preview: Option<Preview>,
 }
 
@@ -404,6 +408,7 @@ impl GlintApp {
         egui::CentralPanel::default_margins().show(ui, |ui| commands.extend(self.image_ui(ui)));
         self.discard_prompt_ui(&ctx);
         self.apply(commands, &ctx);
+        self.sync_octree();
         self.octree_tuning_logic(&ctx);
         self.undoer
             .feed_state(ctx.input(|i| i.time), &self.edit.snapshot());
@@ -590,6 +595,7 @@ impl GlintApp {
             camera: edit.camera,
             settings: edit.settings,
             scene_version: edit.scene_version,
+            octree: self.octree.params(),
             preview: preview.map(|(p, _)| p),
         };
         if self.submitted.as_ref() == Some(&inputs) {
@@ -700,68 +706,6 @@ impl GlintApp {
         (self.inspect.walk.target.as_ref(), self.inspect.walk.shown)
     }
 
-    /// Rebuilds the octree with `params`. Renders nothing: the next render
-    /// (of whatever else changes) uses the new tree.
-    pub fn set_octree_params(&mut self, params: OctreeParams) {
-        let mut scene = (*self.edit.scene).clone();
-        scene.octree_params = params;
-        match build_octree(&scene) {
-            Ok((octree, seconds)) => {
-                self.octree = Arc::new(octree);
-                self.build_seconds = seconds;
-                self.edit.scene = Arc::new(scene);
-            }
-            Err(e) => self.say(format!("octree not rebuilt: {e}"), true),
-        }
-    }
-
-    /// Starts working out a suggested octree setting in the background,
-    /// for the last full pass's rays.
-    fn suggest_octree(&mut self) {
-        let history = self.worker.history();
-        let (Some(costs), Some(pass)) = (self.unit_costs, last_full_pass(&history)) else {
-            return;
-        };
-        self.suggestion = Some(SuggestionJob::start(
-            Arc::clone(&self.edit.scene),
-            costs,
-            pass.rays.total(),
-            self.worker.threads(),
-            self.edit.scene_version,
-        ));
-    }
-
-    /// Measures the unit costs of the installed scene once its first pass
-    /// has shown it renders (a thumbnail render, some tens of milliseconds),
-    /// and drops a suggestion made for another scene.
-    fn octree_tuning_logic(&mut self, ctx: &egui::Context) {
-        if self
-            .suggestion
-            .as_ref()
-            .is_some_and(|s| s.scene_version != self.edit.scene_version)
-        {
-            self.suggestion = None;
-        }
-        if self
-            .suggestion
-            .as_ref()
-            .is_some_and(|s| s.result().is_none())
-        {
-            ctx.request_repaint_after(std::time::Duration::from_millis(100));
-        }
-        if self.unit_costs.is_none() && !self.worker.history().is_empty() {
-            let settings = RenderSettings {
-                use_octree: true,
-                ..self.edit.settings
-            };
-            if let Ok(renderer) =
-                Renderer::with_camera(&self.edit.scene, &self.octree, settings, &self.edit.camera)
-            {
-                self.unit_costs = UnitCosts::measure(&renderer, &self.octree).ok();
-            }
-        }
-    }
-
     /// Writes the displayed frame to a PNG chosen in a save dialog, or, where
     /// no dialog is available, to the pictures directory.
     pub fn export(&mut self) {
@@ -786,12 +730,4 @@ impl eframe::App for GlintApp {
     fn raw_input_hook(&mut self, _ctx: &egui::Context, raw_input: &mut egui::RawInput) {
         self.raw_input_logic(raw_input);
     }
-}
-
-fn build_octree(scene: &Scene) -> anyhow::Result<(Octree, f64)> {
-    let start = Instant::now();
-    let octree = scene
-        .build_octree()
-        .map_err(|e| anyhow::anyhow!("{}: {e}", scene.name))?;
-    Ok((octree, start.elapsed().as_secs_f64()))
 }

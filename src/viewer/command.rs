@@ -27,8 +27,8 @@ pub enum Command {
     InspectPixel(u32, u32),
     /// Keep the frame on screen as "A" of an A/B comparison.
     PinAsA,
-    /// Rebuild the octree with these parameters (renders nothing: the
-    /// image does not depend on them).
+    /// Edit the octree parameters: the tree is rebuilt and the passes
+    /// render again (the same image, in the new tree's time).
     SetOctreeParams(crate::accel::OctreeParams),
     /// Work out a suggested octree setting in the background.
     SuggestOctree,

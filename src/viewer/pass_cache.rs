@@ -12,10 +12,11 @@ use crate::settings::RenderSettings;
 
 /// What decides a pass: the scene (by identity: an edit makes a new one),
 /// the camera, the settings as the pass traces them (its own sampling, the
-/// shaded view for aa-need) and, for the cost views, the octree itself
-/// (its tests are what they show). The octree switch is part of the
-/// settings although the pixels do not depend on it: its time is what a
-/// user toggles it to see.
+/// shaded view for aa-need) and, for the cost views and whenever the
+/// octree is on, the octree itself (its tests are what the cost views
+/// show; its times are what a user rebuilds it to see). The octree switch
+/// is part of the settings although the pixels do not depend on it: its
+/// time is what a user toggles it to see.
 ///
 /// Scene and octree are held weakly: the cache does not keep an edited-away
 /// scene alive, and the allocation a weak pointer holds cannot be reused by
@@ -44,7 +45,7 @@ impl PassKey {
         let counts_tests = matches!(settings.view, ViewMode::Cost | ViewMode::CostSteps);
         PassKey {
             scene: Arc::downgrade(scene),
-            octree: counts_tests.then(|| Arc::downgrade(octree)),
+            octree: (counts_tests || settings.use_octree).then(|| Arc::downgrade(octree)),
             camera,
             settings,
             pass,

@@ -110,6 +110,7 @@ pub fn save(edit: &EditState, destination: &Path) -> anyhow::Result<Saved> {
         lights: &edit.scene.lights,
         materials: &edit.scene.materials,
         settings: &edit.settings,
+        octree: &edit.scene.octree_params,
         mesh_paths: if builtin {
             MeshPaths::Beside
         } else {

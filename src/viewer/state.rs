@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use crate::accel::OctreeParams;
 use crate::camera::CameraSpec;
 use crate::material::{Light, Material};
 use crate::scene::Scene;
@@ -137,13 +138,15 @@ pub struct Snapshot {
     pub settings: RenderSettings,
     pub lights: Vec<Light>,
     pub materials: Vec<Material>,
+    /// The octree's parameters (the app rebuilds the tree to match).
+    pub octree: OctreeParams,
 }
 
 impl Snapshot {
     /// Whether `self` and `other` differ in what "Save scene" writes: the
     /// camera, lights, materials, image size, samples, depth, colours,
-    /// sides and the octree switch (not the view or the protocol, which
-    /// are ways of looking at the scene).
+    /// sides, the octree switch and its parameters (not the view or the
+    /// protocol, which are ways of looking at the scene).
     pub fn differs_in_saved_values(&self, other: &Snapshot) -> bool {
         let saved = |s: &Snapshot| {
             let r = &s.settings;
@@ -161,6 +164,7 @@ impl Snapshot {
         self.camera != other.camera
             || self.lights != other.lights
             || self.materials != other.materials
+            || self.octree != other.octree
             || saved(self) != saved(other)
     }
 }
@@ -173,6 +177,7 @@ impl EditState {
             settings: self.settings,
             lights: self.scene.lights.clone(),
             materials: self.scene.materials.clone(),
+            octree: self.scene.octree_params,
         }
     }
 
@@ -184,6 +189,11 @@ impl EditState {
             let scene = self.scene_mut();
             scene.lights.clone_from(&s.lights);
             scene.materials.clone_from(&s.materials);
+        }
+        // Not a scene edit: the geometry and the picture stay; the app
+        // rebuilds the tree and renders again for its times.
+        if self.scene.octree_params != s.octree {
+            Arc::make_mut(&mut self.scene).octree_params = s.octree;
         }
     }
 

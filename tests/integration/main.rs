@@ -22,5 +22,6 @@ mod source_files;
 mod spd_protocol;
 mod viewer;
 mod viewer_files;
+mod viewer_panels;
 mod viewer_worker;
 mod walk;

@@ -234,6 +234,7 @@ proptest! {
         aa in 0usize..3,
         max_depth in 1u32..=64,
         octree in any::<bool>(),
+        tree in (0u32..=21, 1u32..=64, 1u32..=8, any::<bool>()),
         other_folder in any::<bool>(),
     ) {
         let files = Files { scene: text.clone(), obj: MODEL.to_vec(), mtl: LIBRARY.to_vec() };
@@ -255,6 +256,13 @@ proptest! {
         settings.use_octree = octree;
         let lights: Vec<Light> = loaded.lights.iter().zip(&edits.0).map(|(_, (p, c))| Light { position: *p, color: *c }).collect();
         let materials: Vec<Material> = loaded.materials.iter().zip(edits.1.iter().cycle()).map(|(m, (c, kd, n))| Material { color: *c, kd: *kd, shininess: *n, ..m.clone() }).collect();
+        let octree_params = glint::accel::OctreeParams {
+            max_depth: tree.0,
+            leaf_size: tree.1,
+            max_duplication: tree.2,
+            cost_driven: tree.3,
+            ..loaded.octree_params
+        };
         let request = glint::scene::save::SaveRequest {
             loaded: &loaded,
             loaded_path: path,
@@ -262,6 +270,7 @@ proptest! {
             lights: &lights,
             materials: &materials,
             settings: &settings,
+            octree: &octree_params,
             mesh_paths: glint::scene::save::MeshPaths::Anchored,
         };
         let destination = if other_folder { Path::new("elsewhere/saved.toml") } else { Path::new("dir/saved.toml") };
@@ -275,6 +284,7 @@ proptest! {
         (expected.image.samples, expected.image.adaptive) = (settings.samples, settings.adaptive);
         expected.image.max_depth = max_depth;
         expected.octree_enabled = octree;
+        expected.octree_params = octree_params;
         // The file's own materials and the mesh's MTL ones alike.
         expected.materials.clone_from(&materials);
         prop_assert!(saved.left_out.is_empty(), "{:?}", saved.left_out);
@@ -324,6 +334,7 @@ proptest! {
             lights: &lights,
             materials: &materials,
             settings: &settings,
+            octree: &loaded.octree_params,
             mesh_paths: glint::scene::save::MeshPaths::Anchored,
         };
         let saved = glint::scene::save::scene_nff(&request).unwrap();

@@ -198,3 +198,53 @@ fn exports_record_the_scene_by_its_absolute_path() {
         std::fs::canonicalize(&relative).unwrap()
     );
 }
+
+/// Octree parameters edited in the panel are an edit like any other: the
+/// title marks them, undo takes them back (and the tree with them), the
+/// passes render again with the new tree, and Save writes `[octree]`.
+#[test]
+fn octree_parameters_are_edits() {
+    use egui::{Key, Modifiers};
+    let (_dir, path) = scene_in_temp_folder();
+    let mut h = harness(app_at(&path));
+    settle(&mut h);
+    let loaded = h.state().scene().octree_params;
+    let edited_depth = loaded.max_depth - 3;
+    let renders = h.state().worker().history().len();
+    h.get_by_label("Octree parameters").click();
+    h.run_steps(3);
+    h.get_by_value(&loaded.max_depth.to_string()).focus();
+    h.run_steps(1);
+    h.event(egui::Event::Text(edited_depth.to_string()));
+    h.key_press(Key::Enter);
+    h.run_steps(3);
+    assert_eq!(h.state().scene().octree_params.max_depth, edited_depth);
+    assert_eq!(
+        h.state().octree().params().max_depth,
+        edited_depth,
+        "the tree was rebuilt"
+    );
+    assert!(h.state().unsaved());
+    assert!(h.state().title().starts_with('●'), "{}", h.state().title());
+    settle(&mut h);
+    assert!(
+        h.state().worker().history().len() > renders,
+        "the new tree rendered, for its times"
+    );
+
+    // Undo a second later (edits within a second are one step).
+    std::thread::sleep(std::time::Duration::from_millis(1100));
+    h.run_steps(1);
+    press(&mut h, Modifiers::COMMAND, Key::Z);
+    assert_eq!(h.state().scene().octree_params, loaded);
+    assert_eq!(h.state().octree().params(), loaded, "undo rebuilt the tree");
+    assert!(!h.state().unsaved());
+    press(&mut h, Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+    assert_eq!(h.state().octree().params().max_depth, edited_depth);
+
+    press(&mut h, Modifiers::COMMAND, Key::S);
+    assert!(!h.state().unsaved(), "{:?}", h.state().messages().last());
+    let saved = glint::scene::load(&path).unwrap();
+    assert_eq!(saved.octree_params.max_depth, edited_depth);
+    assert_eq!(saved.octree_params.leaf_size, loaded.leaf_size);
+}

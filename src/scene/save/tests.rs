@@ -36,6 +36,7 @@ fn request<'a>(
         lights: &loaded.lights,
         materials: &loaded.materials,
         settings,
+        octree: &loaded.octree_params,
         mesh_paths: MeshPaths::Anchored,
     }
 }
@@ -263,6 +264,7 @@ fn nff_request<'a>(
         lights,
         materials,
         settings,
+        octree: &loaded.octree_params,
         mesh_paths: MeshPaths::Anchored,
     }
 }
@@ -302,9 +304,14 @@ fn an_nff_scene_is_saved_as_nff_with_its_edits_and_comments() {
     materials[0].kd = 0.5;
     materials[0].ka = 0.5;
     materials[1].reflectivity = 0.25;
-    let saved = scene_nff(&nff_request(
-        &loaded, &camera, &settings, &lights, &materials,
-    ))
+    let tree = crate::accel::OctreeParams {
+        leaf_size: 9,
+        ..loaded.octree_params
+    };
+    let saved = scene_nff(&SaveRequest {
+        octree: &tree,
+        ..nff_request(&loaded, &camera, &settings, &lights, &materials)
+    })
     .unwrap();
     let text = &saved.text;
     for kept in [
@@ -320,13 +327,14 @@ fn an_nff_scene_is_saved_as_nff_with_its_edits_and_comments() {
         saved.left_out,
         [
             LeftOut::Samples,
+            LeftOut::OctreeParams,
             LeftOut::Reflectivity {
                 material: "f2".into()
             }
         ]
     );
     assert_eq!(
-        saved.left_out[1].to_string(),
+        saved.left_out[2].to_string(),
         "the reflectivity of f2 (NFF uses Ks)"
     );
     let again = load_str(text, path, &NoMeshes).unwrap();

@@ -6,6 +6,7 @@ use toml_edit::{Array, DocumentMut, Item, TableLike, Value};
 
 use super::mesh_paths::write_mesh_paths;
 use super::{LeftOut, SaveError, SaveRequest, SavedText, set, tables_of};
+use crate::accel::OctreeParams;
 use crate::camera::CameraSpec;
 use crate::material::{Light, Material};
 use crate::math::DVec3;
@@ -34,6 +35,7 @@ pub fn scene_toml(request: &SaveRequest, destination: &Path) -> Result<SavedText
 
     write_camera(&mut doc, &loaded.camera, request.camera);
     write_settings(&mut doc, loaded, request.settings);
+    write_octree(&mut doc, &loaded.octree_params, request.octree);
     if request.lights.len() != loaded.lights.len() {
         return Err(SaveError::LightCount {
             loaded: loaded.lights.len(),
@@ -86,6 +88,37 @@ fn write_camera(doc: &mut DocumentMut, loaded: &CameraSpec, camera: &CameraSpec)
     }
     if loaded.fov != camera.fov {
         set(t, "fov", Value::from(camera.fov));
+    }
+}
+
+/// The `[octree]` keys whose values were edited.
+fn write_octree(doc: &mut DocumentMut, loaded: &OctreeParams, edited: &OctreeParams) {
+    if loaded == edited {
+        return;
+    }
+    let Some(t) = table(doc, "octree") else {
+        return;
+    };
+    for (key, old, new) in [
+        ("max_depth", loaded.max_depth, edited.max_depth),
+        ("leaf_size", loaded.leaf_size, edited.leaf_size),
+        (
+            "max_duplication",
+            loaded.max_duplication,
+            edited.max_duplication,
+        ),
+        (
+            "memory_budget_mib",
+            loaded.memory_budget_mib,
+            edited.memory_budget_mib,
+        ),
+    ] {
+        if old != new {
+            set(t, key, Value::from(i64::from(new)));
+        }
+    }
+    if loaded.cost_driven != edited.cost_driven {
+        set(t, "cost_driven", Value::from(edited.cost_driven));
     }
 }
 

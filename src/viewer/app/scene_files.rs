@@ -4,7 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use super::{Discarding, GlintApp, build_octree};
+use super::octree_tuning::build_octree;
+use super::{Discarding, GlintApp};
 use crate::scene::Scene;
 use crate::scene::save::LeftOut;
 use crate::settings::RenderSettings;
@@ -123,6 +124,7 @@ impl GlintApp {
                         LeftOut::Colors => b.colors = file.colors,
                         LeftOut::Sides => b.sides = file.sides,
                         LeftOut::OctreeSwitch => b.use_octree = file.use_octree,
+                        LeftOut::OctreeParams => baseline.octree = reloaded.octree_params,
                         // Material edits left out are told, not undone: the
                         // materials came back from the file above.
                         LeftOut::Reflectivity { .. }

@@ -1,0 +1,97 @@
+//! The viewer's octree tuning: the edited parameters, the tree built from
+//! them, the unit costs a prediction needs and the "Suggest a setting" job.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use super::GlintApp;
+use crate::accel::{Octree, OctreeParams};
+use crate::render::{Renderer, UnitCosts};
+use crate::scene::Scene;
+use crate::settings::RenderSettings;
+use crate::viewer::octree_panel::{SuggestionJob, last_full_pass};
+
+impl GlintApp {
+    /// Edits the octree parameters (an edit like any other: undone,
+    /// saved, marked unsaved) and rebuilds the tree; the passes render
+    /// again with it, so the times shown are the new tree's.
+    pub fn set_octree_params(&mut self, params: OctreeParams) {
+        Arc::make_mut(&mut self.edit.scene).octree_params = params;
+        self.sync_octree();
+    }
+
+    /// Rebuilds the octree when the edited parameters (changed by the
+    /// panel, undo or redo) are not the built tree's; a build that fails
+    /// puts the built tree's parameters back, with the reason.
+    pub(super) fn sync_octree(&mut self) {
+        let wanted = self.edit.scene.octree_params;
+        if self.octree.params() == wanted {
+            return;
+        }
+        match build_octree(&self.edit.scene) {
+            Ok((octree, seconds)) => {
+                self.octree = Arc::new(octree);
+                self.build_seconds = seconds;
+            }
+            Err(e) => {
+                Arc::make_mut(&mut self.edit.scene).octree_params = self.octree.params();
+                self.say(format!("octree not rebuilt: {e:#}"), true);
+            }
+        }
+    }
+
+    /// Starts working out a suggested octree setting in the background,
+    /// for the last full pass's rays.
+    pub(super) fn suggest_octree(&mut self) {
+        let history = self.worker.history();
+        let (Some(costs), Some(pass)) = (self.unit_costs, last_full_pass(&history)) else {
+            return;
+        };
+        self.suggestion = Some(SuggestionJob::start(
+            Arc::clone(&self.edit.scene),
+            costs,
+            pass.rays.total(),
+            self.worker.threads(),
+            self.edit.scene_version,
+        ));
+    }
+
+    /// Measures the unit costs of the installed scene once its first pass
+    /// has shown it renders (a thumbnail render, some tens of milliseconds),
+    /// and drops a suggestion made for another scene.
+    pub(super) fn octree_tuning_logic(&mut self, ctx: &egui::Context) {
+        if self
+            .suggestion
+            .as_ref()
+            .is_some_and(|s| s.scene_version != self.edit.scene_version)
+        {
+            self.suggestion = None;
+        }
+        if self
+            .suggestion
+            .as_ref()
+            .is_some_and(|s| s.result().is_none())
+        {
+            ctx.request_repaint_after(std::time::Duration::from_millis(100));
+        }
+        if self.unit_costs.is_none() && !self.worker.history().is_empty() {
+            let settings = RenderSettings {
+                use_octree: true,
+                ..self.edit.settings
+            };
+            if let Ok(renderer) =
+                Renderer::with_camera(&self.edit.scene, &self.octree, settings, &self.edit.camera)
+            {
+                self.unit_costs = UnitCosts::measure(&renderer, &self.octree).ok();
+            }
+        }
+    }
+}
+
+pub(super) fn build_octree(scene: &Scene) -> anyhow::Result<(Octree, f64)> {
+    let start = Instant::now();
+    let octree = scene
+        .build_octree()
+        .map_err(|e| anyhow::anyhow!("{}: {e}", scene.name))?;
+    Ok((octree, start.elapsed().as_secs_f64()))
+}
