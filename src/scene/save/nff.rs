@@ -34,13 +34,7 @@ pub fn scene_nff(request: &SaveRequest) -> Result<SavedText, SaveError> {
             edited: request.lights.len(),
         });
     }
-    let number = |x: f64| format!("{x:?}");
     let mut edits: Vec<(Range<usize>, String)> = Vec::new();
-    let mut put = |ranges: &[Range<usize>], values: &[f64]| {
-        for (r, &x) in ranges.iter().zip(values) {
-            edits.push((r.clone(), number(x)));
-        }
-    };
     let mut left_out = Vec::new();
 
     let s = request.settings;
@@ -54,16 +48,20 @@ pub fn scene_nff(request: &SaveRequest) -> Result<SavedText, SaveError> {
             (&view.at, old.lookat, new.lookat),
             (&view.up, old.up, new.up),
         ] {
-            if a != b {
-                put(ranges, &b.to_array());
-            }
+            put(&mut edits, text, ranges, &a.to_array(), &b.to_array());
         }
         // NFF's angle depends on the row count; the field of view is kept.
-        if old.fov != new.fov || resize {
-            put(
-                std::slice::from_ref(&view.angle),
-                &[crate::scene::nff::nff_angle_from_fov(new.fov, rows)],
-            );
+        // A written angle that gives the field of view at this row count
+        // stays as written (45, not 44.92069306851313).
+        let written: Option<f64> = text[view.angle.clone()].parse().ok();
+        let keeps_fov =
+            written.is_some_and(|a| crate::scene::nff::fov_from_nff_angle(a, rows) == new.fov);
+        if (old.fov != new.fov || resize) && !keeps_fov {
+            let angle = crate::scene::nff::nff_angle_from_fov(new.fov, rows);
+            edits.push((
+                view.angle.clone(),
+                number_like(angle, &text[view.angle.clone()]),
+            ));
         }
         if resize {
             edits.push((view.resolution[0].clone(), s.width.to_string()));
@@ -88,25 +86,38 @@ pub fn scene_nff(request: &SaveRequest) -> Result<SavedText, SaveError> {
     if s.use_octree != loaded.octree_enabled {
         left_out.push(LeftOut::OctreeSwitch);
     }
+    if *request.octree != loaded.octree_params {
+        left_out.push(LeftOut::OctreeParams);
+    }
 
     for ((place, old), new) in layout.lights.iter().zip(&loaded.lights).zip(request.lights) {
-        let mut put = |ranges: &[Range<usize>], values: &[f64]| {
-            for (r, &x) in ranges.iter().zip(values) {
-                edits.push((r.clone(), number(x)));
-            }
-        };
-        if old.position != new.position {
-            put(&place.position, &new.position.to_array());
-        }
+        put(
+            &mut edits,
+            text,
+            &place.position,
+            &old.position.to_array(),
+            &new.position.to_array(),
+        );
         if old.color != new.color {
             match &place.color {
-                Some(ranges) => put(ranges, &new.color.to_array()),
+                Some(ranges) => put(
+                    &mut edits,
+                    text,
+                    ranges,
+                    &old.color.to_array(),
+                    &new.color.to_array(),
+                ),
                 None => {
                     let end = place.position[2].end;
                     let c = new.color;
                     edits.push((
                         end..end,
-                        format!(" {} {} {}", number(c.x), number(c.y), number(c.z)),
+                        format!(
+                            " {} {} {}",
+                            number_like(c.x, ""),
+                            number_like(c.y, ""),
+                            number_like(c.z, "")
+                        ),
                     ));
                 }
             }
@@ -124,39 +135,24 @@ pub fn scene_nff(request: &SaveRequest) -> Result<SavedText, SaveError> {
                 material: old.name.clone(),
             });
         }
-        // Every number of the material's `f` lines is written: the file's
-        // own may differ from the loaded value (an opaque material's index
-        // of refraction is often written 0 and loaded as 1).
-        let values = [
-            new.color.x,
-            new.color.y,
-            new.color.z,
-            new.kd,
-            new.ks,
-            new.shininess,
-            new.transparency,
-            new.ior,
-        ];
+        // The changed numbers of every `f` line of the material, and the
+        // index of refraction where the file's own differs from the one
+        // used (an opaque material's is often written 0 and loaded as 1; a
+        // material made transparent needs one the file can load).
+        let (before, after) = (nff_key(old), nff_key(new));
         for entity in layout.materials.get(i).into_iter().flatten() {
-            for (r, &x) in entity.iter().zip(&values) {
-                edits.push((r.clone(), number(x)));
+            for (k, r) in entity.iter().enumerate().take(after.len()) {
+                let token = &text[r.clone()];
+                let ior_needed =
+                    k == 7 && new.transparency > 0.0 && token.parse::<f64>() != Ok(after[k]);
+                if before[k] != after[k] || ior_needed {
+                    edits.push((r.clone(), number_like(after[k], token)));
+                }
             }
         }
     }
     // NFF gives one material to equal `f` lines: materials edited to be
     // equal are one material when the file is read again.
-    let nff_key = |m: &Material| {
-        [
-            m.color.x,
-            m.color.y,
-            m.color.z,
-            m.kd,
-            m.ks,
-            m.shininess,
-            m.transparency,
-            m.ior,
-        ]
-    };
     for (i, a) in request.materials.iter().enumerate() {
         if let Some(b) = request.materials[..i]
             .iter()
@@ -182,4 +178,49 @@ pub fn scene_nff(request: &SaveRequest) -> Result<SavedText, SaveError> {
         text: out,
         left_out,
     })
+}
+
+/// Rewrites the numbers at `ranges` whose values changed from `old` to
+/// `new`, each in its token's style.
+fn put(
+    edits: &mut Vec<(Range<usize>, String)>,
+    text: &str,
+    ranges: &[Range<usize>],
+    old: &[f64],
+    new: &[f64],
+) {
+    for ((r, &a), &b) in ranges.iter().zip(old).zip(new) {
+        if a != b {
+            edits.push((r.clone(), number_like(b, &text[r.clone()])));
+        }
+    }
+}
+
+/// A material's numbers in the order of its `f` line.
+fn nff_key(m: &Material) -> [f64; 8] {
+    [
+        m.color.x,
+        m.color.y,
+        m.color.z,
+        m.kd,
+        m.ks,
+        m.shininess,
+        m.transparency,
+        m.ior,
+    ]
+}
+
+/// `x` written in the style of the number it replaces: a whole number
+/// stays whole where the file wrote one without a point (`3`, not `3.0`);
+/// otherwise the shortest text that reads back as `x`.
+fn number_like(x: f64, token: &str) -> String {
+    let plain_integer = !token.is_empty()
+        && token
+            .bytes()
+            .all(|b| b.is_ascii_digit() || b == b'-' || b == b'+');
+    if plain_integer && x.fract() == 0.0 && x.abs() < 1e15 {
+        format!("{}", x as i64)
+    } else {
+        format!("{x:?}")
+    }
 }
