@@ -5,9 +5,11 @@
 use std::path::{Path, PathBuf};
 
 use super::export::file_dialog_available;
-use super::state::{EditState, SceneSource};
+use super::state::{EditState, SceneSource, Snapshot};
+use crate::accel::OctreeParams;
 use crate::scene::Scene;
 use crate::scene::save::{MeshPaths, SaveRequest, scene_nff, scene_toml};
+use crate::settings::RenderSettings;
 
 /// Whether "Save scene" can write into the scene's own file: a TOML or an
 /// NFF scene file can be edited in place (the built-in scene and an OBJ
@@ -86,8 +88,11 @@ pub struct Saved {
 }
 
 /// Writes `edit` to `destination` (TOML, or NFF for an NFF scene) and
-/// loads the file back.
-pub fn save(edit: &EditState, destination: &Path) -> anyhow::Result<Saved> {
+/// loads the file back. Only edits are written: a value the same as in
+/// `baseline` (the edits as last loaded or saved) is the file's own, so a
+/// command-line `--size` or octree flag, a way of looking at the scene,
+/// does not end up in it.
+pub fn save(edit: &EditState, baseline: &Snapshot, destination: &Path) -> anyhow::Result<Saved> {
     let extension = if is_nff(&edit.source) { "nff" } else { "toml" };
     let named_right = destination
         .extension()
@@ -103,14 +108,15 @@ pub fn save(edit: &EditState, destination: &Path) -> anyhow::Result<Saved> {
         Some(p) => p.to_owned(),
         None => PathBuf::from("scenes/default.toml"),
     };
+    let (settings, octree) = edited_only(edit, baseline);
     let request = SaveRequest {
         loaded: &edit.loaded,
         loaded_path: &loaded_path,
         camera: &edit.camera,
         lights: &edit.scene.lights,
         materials: &edit.scene.materials,
-        settings: &edit.settings,
-        octree: &edit.scene.octree_params,
+        settings: &settings,
+        octree: &octree,
         mesh_paths: if builtin {
             MeshPaths::Beside
         } else {
@@ -134,6 +140,58 @@ pub fn save(edit: &EditState, destination: &Path) -> anyhow::Result<Saved> {
         scene,
         left_out: saved.left_out,
     })
+}
+
+/// The settings and octree parameters to save: each value the user has
+/// not changed since `baseline` is put back to the file's.
+fn edited_only(edit: &EditState, baseline: &Snapshot) -> (RenderSettings, OctreeParams) {
+    let file = edit.loaded.render_settings();
+    let (was, now) = (&baseline.settings, &edit.settings);
+    let mut s = *now;
+    if (now.width, now.height) == (was.width, was.height) {
+        (s.width, s.height) = (file.width, file.height);
+    }
+    if (now.samples, now.adaptive) == (was.samples, was.adaptive) {
+        (s.samples, s.adaptive) = (file.samples, file.adaptive);
+    }
+    if now.max_depth == was.max_depth {
+        s.max_depth = file.max_depth;
+    }
+    if now.colors == was.colors {
+        s.colors = file.colors;
+    }
+    if now.sides == was.sides {
+        s.sides = file.sides;
+    }
+    if now.use_octree == was.use_octree {
+        s.use_octree = file.use_octree;
+    }
+    let (file, was, now) = (
+        &edit.loaded.octree_params,
+        &baseline.octree,
+        &edit.scene.octree_params,
+    );
+    let keep = |a: u32, b: u32, f: u32| if a == b { f } else { a };
+    let octree = OctreeParams {
+        max_depth: keep(now.max_depth, was.max_depth, file.max_depth),
+        leaf_size: keep(now.leaf_size, was.leaf_size, file.leaf_size),
+        max_duplication: keep(
+            now.max_duplication,
+            was.max_duplication,
+            file.max_duplication,
+        ),
+        memory_budget_mib: keep(
+            now.memory_budget_mib,
+            was.memory_budget_mib,
+            file.memory_budget_mib,
+        ),
+        cost_driven: if now.cost_driven == was.cost_driven {
+            file.cost_driven
+        } else {
+            now.cost_driven
+        },
+    };
+    (s, octree)
 }
 
 /// The built-in scene's mesh, written beside a copy of the scene (a file

@@ -248,3 +248,65 @@ fn octree_parameters_are_edits() {
     assert_eq!(saved.octree_params.max_depth, edited_depth);
     assert_eq!(saved.octree_params.leaf_size, loaded.leaf_size);
 }
+
+/// Command-line settings (`--size`, octree flags) are ways of looking at
+/// the scene, not edits: a save after editing a light writes the light
+/// and leaves `resolution`, `angle` and `[octree]` as the files have them.
+#[test]
+fn command_line_settings_are_not_saved_as_edits() {
+    use egui::{Key, Modifiers};
+    use glint::settings::{OctreeOverrides, Overrides};
+    let dir = tempfile::tempdir().unwrap();
+    let overrides = Overrides {
+        width: Some(90),
+        height: Some(70),
+        octree: OctreeOverrides {
+            leaf_size: Some(2),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let nff = dir.path().join("balls.nff");
+    let nff_text = "v\nfrom 0 -4 1\nat 0 0 0\nup 0 0 1\nangle 45\nhither 0.01\n\
+                    resolution 64 48\nb 0.1 0.2 0.3\nl 2 -18 -5\n\
+                    f 1 0.5 0.2 0.7 0.3 20 0 1\ns 0 0 0 1\n";
+    std::fs::write(&nff, nff_text).unwrap();
+    let (_toml_dir, toml) = scene_in_temp_folder();
+    let toml_text = std::fs::read_to_string(&toml).unwrap();
+    for (path, text, edited) in [
+        (
+            &nff,
+            nff_text.to_owned(),
+            nff_text.replace("l 2 -18 -5", "l 3 -18 -5"),
+        ),
+        (&toml, toml_text.clone(), String::new()),
+    ] {
+        let options = ViewerOptions {
+            overrides,
+            ..Default::default()
+        };
+        let app = GlintApp::new(SceneSource::File(path.clone()), options, || {}).unwrap();
+        let mut h = harness(app);
+        assert!(!h.state().unsaved(), "the flags are not edits");
+        assert_eq!(h.state().octree().params().leaf_size, 2);
+        h.state_mut().scene_mut().lights[0].position.x = 3.0;
+        h.run_steps(2);
+        press(&mut h, Modifiers::COMMAND, Key::S);
+        assert!(!h.state().unsaved(), "{:?}", h.state().messages().last());
+        let written = std::fs::read_to_string(path).unwrap();
+        if edited.is_empty() {
+            assert!(!written.contains("width = 90"), "{written}");
+            assert!(!written.contains("leaf_size"), "{written}");
+            let saved = glint::scene::load(path).unwrap();
+            assert_eq!(saved.lights[0].position.x, 3.0);
+            assert_eq!(
+                saved.image,
+                glint::scene::load_str(&text, path, &glint::scene::FileSystem)
+                    .unwrap()
+                    .image
+            );
+        } else {
+            assert_eq!(written, edited);
+        }
+    }
+}

@@ -449,3 +449,51 @@ fn mesh_paths_follow_the_file_to_another_folder() {
     );
     assert_eq!(doc(MeshPaths::Beside, "/nonexistent/a/copy.toml"), "m.obj");
 }
+
+/// Only edited numbers are rewritten, each in its token's style: moving a
+/// light along x leaves its other coordinates as written and keeps whole
+/// numbers whole; a width change (same rows) keeps `angle 45`, which
+/// still gives the field of view.
+#[test]
+fn nff_saves_rewrite_only_edited_numbers_in_the_files_style() {
+    let text = "v\nfrom 0 -4 1\nat 0 0 0\nup 0 0 1\nangle 45\nhither 0.01\n\
+                resolution 64 48\nb 0.1 0.2 0.3\nl 2 -18 -5\nl 1.50 2 3 1 1 1\n\
+                f 1 0.5 0.2 0.7 0.3 20 0 0\ns 0 0 0 1\n";
+    let path = Path::new("dir/balls.nff");
+    let loaded = load_str(text, path, &NoMeshes).unwrap();
+    let mut lights = loaded.lights.clone();
+    lights[0].position.x = 3.0;
+    lights[1].position.y = 2.25;
+    let mut materials = loaded.materials.clone();
+    materials[0].kd = 0.25;
+    let mut settings = loaded.render_settings();
+    settings.width = 80;
+    let saved = scene_nff(&nff_request(
+        &loaded,
+        &loaded.camera,
+        &settings,
+        &lights,
+        &materials,
+    ))
+    .unwrap();
+    let expected = text
+        .replace("l 2 -18 -5", "l 3 -18 -5")
+        .replace("l 1.50 2 3", "l 1.50 2.25 3")
+        .replace("0.2 0.7 0.3", "0.2 0.25 0.3")
+        .replace("resolution 64 48", "resolution 80 48");
+    assert_eq!(saved.text, expected);
+    // A changed field of view is written as an angle that reads back as it.
+    let mut camera = loaded.camera;
+    camera.fov = 30.0;
+    let saved = scene_nff(&nff_request(
+        &loaded,
+        &camera,
+        &loaded.render_settings(),
+        &loaded.lights,
+        &loaded.materials,
+    ))
+    .unwrap();
+    assert!(!saved.text.contains("angle 45"), "{}", saved.text);
+    let again = load_str(&saved.text, path, &NoMeshes).unwrap();
+    assert!((again.camera.fov - 30.0).abs() < 1e-12);
+}

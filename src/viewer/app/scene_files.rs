@@ -85,7 +85,7 @@ impl GlintApp {
 
     /// Saves to `path`; the saved file becomes the scene's source.
     pub fn save_to(&mut self, path: &Path) {
-        match save::save(&self.edit, path) {
+        match save::save(&self.edit, &self.saved, path) {
             Ok(saved) => {
                 let shown = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_owned());
                 let name = saved.scene.name.clone();
