@@ -99,6 +99,8 @@ pub struct GlintApp {
     saved: Snapshot,
     /// An action that would drop unsaved edits, waiting for the user's word.
     discarding: Option<Discarding>,
+    /// The path typed where no file dialog is available (Ctrl+O).
+    open_prompt: Option<scene_files::OpenPrompt>,
     /// The window title last sent.
     title: String,
     /// How the image is scaled into its panel.
@@ -168,6 +170,7 @@ impl GlintApp {
             undoer: Default::default(),
             saved,
             discarding: None,
+            open_prompt: None,
             title: String::new(),
             magnification: Magnification::default(),
             octree: Arc::new(octree),
@@ -407,6 +410,7 @@ impl GlintApp {
             });
         egui::CentralPanel::default_margins().show(ui, |ui| commands.extend(self.image_ui(ui)));
         self.discard_prompt_ui(&ctx);
+        self.open_prompt_ui(&ctx);
         self.apply(commands, &ctx);
         self.sync_octree();
         self.octree_tuning_logic(&ctx);

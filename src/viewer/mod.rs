@@ -26,5 +26,6 @@ mod walk_view;
 pub mod worker;
 
 pub use app::{GlintApp, ViewerOptions};
+pub use export::file_dialog_available;
 pub use pixel::WalkTarget;
 pub use state::SceneSource;

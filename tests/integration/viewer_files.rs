@@ -310,3 +310,46 @@ fn command_line_settings_are_not_saved_as_edits() {
         }
     }
 }
+
+/// Without a file dialog (no desktop portal, as under Xvfb and in CI),
+/// Ctrl+O offers a path field: a missing file is refused in it, an
+/// existing one opens.
+#[test]
+fn ctrl_o_without_a_dialog_offers_a_path_field() {
+    use egui::{Key, Modifiers};
+    if glint::viewer::file_dialog_available() {
+        eprintln!("a desktop portal is available here: the field is not shown");
+        return;
+    }
+    let (_dir, path) = scene_in_temp_folder();
+    let mut h = harness(app_at(&path));
+    press(&mut h, Modifiers::COMMAND, Key::O);
+    h.get_by_label_contains("No file dialog is available here");
+    h.run_steps(2);
+    h.event(egui::Event::Text("no/such/scene.toml".into()));
+    h.key_press(Key::Enter);
+    h.run_steps(3);
+    h.get_by_label_contains("no/such/scene.toml: no such file");
+    let glass = common::repo_path("scenes/glass.toml");
+    // The refused path's field has the focus again: select all, retype.
+    h.event(egui::Event::Key {
+        key: Key::A,
+        physical_key: None,
+        pressed: true,
+        repeat: false,
+        modifiers: Modifiers::COMMAND,
+    });
+    h.event(egui::Event::Text(glass.display().to_string()));
+    h.key_press(Key::Enter);
+    h.run_steps(3);
+    assert!(
+        h.query_by_label_contains("No file dialog is available here")
+            .is_none(),
+        "the field closed"
+    );
+    assert!(
+        h.state().scene().name.ends_with("glass.toml"),
+        "{}",
+        h.state().scene().name
+    );
+}

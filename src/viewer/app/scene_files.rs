@@ -228,18 +228,98 @@ impl GlintApp {
 
     pub(super) fn open_dialog(&mut self) {
         if !export::file_dialog_available() {
-            self.say("no file dialog is available here (no desktop portal); pass the scene on the command line: glint view SCENE", true);
+            // A path field instead (Xvfb, minimal desktops).
+            self.open_prompt = Some(OpenPrompt::default());
             return;
         }
         if let Some(path) = rfd::FileDialog::new()
             .add_filter("scenes and models", &["toml", "nff", "obj"])
             .pick_file()
         {
-            if self.unsaved() {
-                self.discarding = Some(Discarding::Open(path));
-            } else {
-                self.open(path);
+            self.open_asking_first(path);
+        }
+    }
+
+    fn open_asking_first(&mut self, path: PathBuf) {
+        if self.unsaved() {
+            self.discarding = Some(Discarding::Open(path));
+        } else {
+            self.open(path);
+        }
+    }
+
+    /// Where no file dialog is available: a field for the scene's path,
+    /// checked before it is opened.
+    pub(super) fn open_prompt_ui(&mut self, ctx: &egui::Context) {
+        let Some(prompt) = &mut self.open_prompt else {
+            return;
+        };
+        let mut chosen = None;
+        let mut cancel = false;
+        egui::Modal::new(egui::Id::unique("open-scene")).show(ctx, |ui| {
+            ui.heading("Open a scene");
+            ui.label(
+                "No file dialog is available here (no desktop portal). \
+                 Type the path of a scene (.toml, .nff or .obj):",
+            );
+            if let Ok(dir) = std::env::current_dir() {
+                ui.weak(format!("relative to {}", dir.display()));
+            }
+            let field = ui.add(
+                egui::TextEdit::singleline(&mut prompt.text)
+                    .desired_width(420.0)
+                    .hint_text("scenes/glass.toml"),
+            );
+            if !prompt.focused {
+                field.request_focus();
+                prompt.focused = true;
+            }
+            let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+            if let Some(error) = &prompt.error {
+                ui.colored_label(ui.visuals().error_fg_color, error);
+            }
+            ui.horizontal(|ui| {
+                if ui.button("Open").clicked() || entered {
+                    chosen = Some(PathBuf::from(prompt.text.trim()));
+                }
+                if ui.button("Cancel").clicked() || ui.input(|i| i.key_pressed(egui::Key::Escape)) {
+                    cancel = true;
+                }
+            });
+        });
+        if cancel {
+            self.open_prompt = None;
+            return;
+        }
+        let Some(path) = chosen else { return };
+        let refusal = if path.as_os_str().is_empty() {
+            Some("type a path".to_owned())
+        } else if !path.is_file() {
+            Some(format!("{}: no such file", path.display()))
+        } else {
+            None
+        };
+        match refusal {
+            Some(error) => {
+                if let Some(prompt) = &mut self.open_prompt {
+                    prompt.error = Some(error);
+                    prompt.focused = false;
+                }
+            }
+            None => {
+                self.open_prompt = None;
+                self.open_asking_first(path);
             }
         }
     }
+}
+
+/// The Ctrl+O path field shown where no file dialog is available.
+#[derive(Debug, Default)]
+pub(super) struct OpenPrompt {
+    text: String,
+    /// Why the last path was refused.
+    error: Option<String>,
+    /// Focus was given to the field (once, so a click elsewhere stays).
+    focused: bool,
 }
