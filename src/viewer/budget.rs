@@ -1,7 +1,8 @@
 //! The frame budget while the user drags: which preview (resolution,
 //! reflections, shadows) fits the time, estimated from the passes so far.
 
-use super::worker::{PassKind, PassRecord, Preview, Reflections};
+use super::worker::{PassRecord, Preview, Reflections};
+use crate::render::PassKind as Engine;
 use crate::settings::RenderSettings;
 
 /// The preview to render while the user drags: the best image whose estimated time fits the frame budget. Candidates in order
@@ -22,11 +23,9 @@ pub fn choose_preview(
         reflections: Reflections::All,
         shadows: true,
     };
-    let Some(base) = history
-        .iter()
-        .rev()
-        .find(|r| matches!(r.kind, PassKind::OneSample | PassKind::Corners))
-    else {
+    let Some(base) = history.iter().rev().find(|r| {
+        r.kind.preview.is_none() && matches!(r.kind.pass, Engine::OneSample | Engine::Corners)
+    }) else {
         return Some((fallback, f64::NAN));
     };
     let estimate = |p: &Preview| estimate_preview(base, p, settings);
@@ -40,8 +39,8 @@ pub fn choose_preview(
     let correction = history
         .iter()
         .rev()
-        .find_map(|r| match r.kind {
-            PassKind::Preview(p) if r.finished_at > base.finished_at => {
+        .find_map(|r| match r.kind.preview {
+            Some(p) if r.finished_at > base.finished_at => {
                 Some((r.seconds / estimate(&p)).clamp(1.0, 4.0))
             }
             _ => None,
@@ -55,7 +54,7 @@ pub fn choose_preview(
         let mut times: Vec<f64> = history
             .iter()
             .rev()
-            .filter(|r| r.kind == PassKind::Preview(*p) && r.finished_at > base.finished_at)
+            .filter(|r| r.kind.preview == Some(*p) && r.finished_at > base.finished_at)
             .take(3)
             .map(|r| r.seconds)
             .collect();
@@ -127,11 +126,12 @@ fn estimate_preview(base: &PassRecord, preview: &Preview, settings: &RenderSetti
 mod tests {
     use super::*;
     use crate::stats::RayCounts;
+    use crate::viewer::worker::ShownPass;
 
     fn base() -> PassRecord {
         PassRecord {
             generation: 1,
-            kind: PassKind::OneSample,
+            kind: ShownPass::full(Engine::OneSample),
             seconds: 0.4,
             // 100 eye rays, 80 hit; 40 secondary rays; 240 shadow rays.
             rays: RayCounts {
@@ -208,7 +208,7 @@ mod tests {
         // model is scaled by 4, so 1/2 bare (4 x 26 ms) no longer fits 33 ms
         // and 1/4 bare (4 x 6.6 ms) does.
         let mut slow = base();
-        slow.kind = PassKind::Preview(Preview {
+        slow.kind = ShownPass::drag_preview(Preview {
             divisor: 4,
             reflections: Reflections::All,
             shadows: true,
@@ -242,7 +242,7 @@ mod tests {
             shadows: true,
         };
         let at = |kind, seconds, finished_at| PassRecord {
-            kind: PassKind::Preview(kind),
+            kind: ShownPass::drag_preview(kind),
             seconds,
             finished_at,
             ..base()

@@ -4,7 +4,7 @@
 
 use egui::{Color32, Pos2, Rect, Sense, Stroke, TextureHandle, TextureOptions};
 
-use super::worker::{PassKind, PassRecord, Worker};
+use super::worker::{PassRecord, Worker};
 
 /// A frame kept as "A" for comparison with the live image ("B").
 #[derive(Clone, Debug)]
@@ -66,7 +66,7 @@ pub struct Compare {
 pub fn timing_label(history: &[PassRecord], generation: u64) -> String {
     let parts: Vec<String> = history
         .iter()
-        .filter(|r| r.generation == generation && !matches!(r.kind, PassKind::Preview(_)))
+        .filter(|r| r.generation == generation && !r.kind.preview.is_some())
         .map(|r| format!("{} {:.3} s", r.kind.label(), r.seconds))
         .collect();
     if parts.is_empty() {
@@ -296,8 +296,10 @@ impl Compare {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::PassKind as Engine;
     use crate::settings::ViewMode;
     use crate::stats::RayCounts;
+    use crate::viewer::worker::ShownPass;
 
     #[test]
     fn differences_count_pixels_and_the_largest_channel_step() {
@@ -335,16 +337,16 @@ mod tests {
             protocol: crate::settings::Protocol::Glint,
             from_cache: false,
         };
-        let preview = PassKind::Preview(super::super::worker::Preview {
+        let preview = ShownPass::drag_preview(super::super::worker::Preview {
             divisor: 2,
             reflections: super::super::worker::Reflections::All,
             shadows: true,
         });
         let history = [
-            pass(1, PassKind::OneSample, 0.5),
+            pass(1, ShownPass::full(Engine::OneSample), 0.5),
             pass(2, preview, 0.01),
-            pass(2, PassKind::OneSample, 0.125),
-            pass(2, PassKind::SixteenSamples, 1.5),
+            pass(2, ShownPass::full(Engine::OneSample), 0.125),
+            pass(2, ShownPass::full(Engine::Grid), 1.5),
         ];
         assert_eq!(
             timing_label(&history, 2),

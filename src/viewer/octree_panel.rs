@@ -8,9 +8,10 @@ use std::sync::{Arc, Mutex};
 use egui::DragValue;
 
 use super::command::Command;
-use super::worker::{PassKind, PassRecord};
+use super::worker::PassRecord;
 use crate::accel::{Octree, OctreeParams};
 use crate::limits::MAX_OCTREE_DEPTH;
+use crate::render::PassKind as Engine;
 use crate::render::{OctreeCandidate, Prediction, UnitCosts, suggest_octree};
 use crate::scene::Scene;
 
@@ -83,20 +84,17 @@ pub struct OctreeInfo<'a> {
 
 /// The last pass that was not a drag preview.
 pub fn last_full_pass(history: &[PassRecord]) -> Option<&PassRecord> {
-    history
-        .iter()
-        .rev()
-        .find(|r| !matches!(r.kind, PassKind::Preview(_)))
+    history.iter().rev().find(|r| !r.kind.preview.is_some())
 }
 
 /// The prediction for the current tree and the last pass's rays.
 pub fn prediction(info: &OctreeInfo) -> Option<(Prediction, &'static str)> {
     let costs = info.unit_costs?;
     let pass = info.last_pass?;
-    let kind = match pass.kind {
-        PassKind::SixteenSamples => "16-sample pass",
-        PassKind::Corners => "SPD pass",
-        _ => "1-sample pass",
+    let kind = match pass.kind.pass {
+        Engine::Grid | Engine::Refine => "16-sample pass",
+        Engine::Corners => "SPD pass",
+        Engine::OneSample => "1-sample pass",
     };
     Some((
         costs.predict(

@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 
 use egui::{Event, Modifiers, PointerButton, Pos2};
 
-use super::worker::{PassKind, PassRecord, PreviewCounts};
+use super::worker::{PassRecord, PreviewCounts, ShownPass};
 
 /// What the benchmark drives.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -32,7 +32,7 @@ pub struct ShownFrame {
     pub generation: u64,
     /// The input serial of the job it came from.
     pub serial: u64,
-    pub pass: Option<PassKind>,
+    pub pass: Option<ShownPass>,
     pub finished: bool,
 }
 
@@ -203,7 +203,7 @@ impl OrbitBench {
             drag.older_than_shown += 1;
         }
         drag.newest_shown_serial = drag.newest_shown_serial.max(frame.serial);
-        if matches!(frame.pass, Some(PassKind::Preview(_)))
+        if frame.pass.is_some_and(|p| p.preview.is_some())
             && frame.finished
             && frame.generation != drag.last_preview_generation
         {
@@ -292,7 +292,7 @@ fn report(
         .iter()
         .filter(|r| r.generation > drag.first_generation)
     {
-        let PassKind::Preview(p) = r.kind else {
+        let Some(p) = r.kind.preview else {
             continue;
         };
         let name = p.describe();

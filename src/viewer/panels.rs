@@ -8,7 +8,7 @@ use egui::{Color32, DragValue, RichText};
 use super::command::Command;
 use super::inspect::InspectState;
 use super::state::EditState;
-use super::worker::{PassKind, Preview, Worker};
+use super::worker::{Preview, Worker};
 use crate::accel::Octree;
 use crate::color::ColorConvention;
 use crate::math::DVec3;
@@ -374,7 +374,7 @@ pub fn status_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) -> Vec<
             // The buffer describes the image before until the new job's
             // first pass starts: that image is neither "done" nor the
             // progress of the new one.
-            Some((Some(pass), .., false, false)) if !matches!(pass, PassKind::Preview(_)) => {
+            Some((Some(pass), .., false, false)) if !pass.preview.is_some() => {
                 ui.label("starting the new image…");
             }
             Some((Some(pass), done, total, _, _, true, _)) => {
@@ -385,7 +385,7 @@ pub fn status_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) -> Vec<
                 ));
             }
             Some((Some(pass), done, total, finished, elapsed, false, _)) => {
-                if let PassKind::Preview(p) = pass {
+                if let Some(p) = pass.preview {
                     // A drag's frames: the full passes follow on release.
                     ui.label(format!(
                         "moving: preview {} ({}x{}); the full image follows when you let go",

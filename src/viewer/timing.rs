@@ -8,7 +8,8 @@ use egui_plot::{Legend, Line, Plot, Points};
 use super::inspect::InspectState;
 use super::panels::RenderInfo;
 use super::state::EditState;
-use super::worker::{PassKind, PassRecord, Worker};
+use super::worker::{PassRecord, ShownPass, Worker};
+use crate::render::PassKind as Engine;
 use crate::settings::ViewMode;
 
 /// Pass times and ray counts, the octree's figures, the view's legend and
@@ -94,7 +95,7 @@ fn timing_grid_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
     let newest_record = history
         .iter()
         .rev()
-        .find(|r| !matches!(r.kind, PassKind::Preview(_)))
+        .find(|r| !r.kind.preview.is_some())
         .map(|r| r.generation);
     let submitted = info.worker.full_generation();
     let shown = match newest_record {
@@ -102,11 +103,11 @@ fn timing_grid_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
         _ if submitted > 0 => Some(submitted),
         other => other,
     };
-    let of_shown = |kind: PassKind| {
+    let of_shown = |kind: fn(ShownPass) -> bool| {
         history
             .iter()
             .rev()
-            .find(|r| Some(r.generation) == shown && r.kind == kind)
+            .find(|r| Some(r.generation) == shown && kind(r.kind))
     };
     let (stopped, finished) = info
         .worker
@@ -131,11 +132,11 @@ fn timing_grid_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
             } else {
                 "–"
             };
-            if let Some(r) = of_shown(PassKind::Corners) {
+            if let Some(r) = of_shown(|k| k == ShownPass::full(Engine::Corners)) {
                 row("SPD corner pass", pass_time(r));
             } else {
-                let one = of_shown(PassKind::OneSample);
-                let sixteen = of_shown(PassKind::SixteenSamples);
+                let one = of_shown(|k| k == ShownPass::full(Engine::OneSample));
+                let sixteen = of_shown(ShownPass::is_grid);
                 row("1-sample pass", one.map_or(pending.into(), pass_time));
                 if edit.settings.samples > 1 || sixteen.is_some() {
                     // Which 16-sample pass ran: the two differ in time
@@ -182,10 +183,7 @@ fn timing_grid_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
                 }
             }
             if let Some((p, estimate)) = info.last_preview {
-                let measured = history
-                    .iter()
-                    .rev()
-                    .find(|r| r.kind == PassKind::Preview(p));
+                let measured = history.iter().rev().find(|r| r.kind.preview == Some(p));
                 row(
                     "while moving",
                     match measured {
@@ -272,7 +270,9 @@ fn time_tick_label(value: f64, step: f64, right_edge: f64) -> String {
 #[derive(Clone, Copy, PartialEq)]
 struct SeriesKey {
     octree: bool,
-    kind: PassKind,
+    /// The full pass (adaptive refinement counted with the full grid: the
+    /// same anti-aliasing, as a user sees it).
+    kind: Engine,
     view: ViewMode,
 }
 
@@ -280,7 +280,11 @@ impl SeriesKey {
     fn of(r: &PassRecord) -> Self {
         Self {
             octree: r.octree,
-            kind: r.kind,
+            kind: if r.kind.is_grid() {
+                Engine::Grid
+            } else {
+                r.kind.pass
+            },
             view: r.view,
         }
     }
@@ -288,9 +292,9 @@ impl SeriesKey {
     /// E.g. "octree on, 16 spp" or "octree off, 1 spp, cost view".
     fn name(&self) -> String {
         let kind = match self.kind {
-            PassKind::SixteenSamples => "16 spp",
-            PassKind::Corners => "SPD corners",
-            _ => "1 spp",
+            Engine::Grid | Engine::Refine => "16 spp",
+            Engine::Corners => "SPD corners",
+            Engine::OneSample => "1 spp",
         };
         let mut name = format!("octree {}, {kind}", if self.octree { "on" } else { "off" });
         if self.view != ViewMode::Shaded {
@@ -319,7 +323,7 @@ fn pass_plot_ui(history: &[PassRecord], ui: &mut egui::Ui) {
     // Passes shown again from the cache took no time now.
     let full: Vec<_> = history
         .iter()
-        .filter(|r| !matches!(r.kind, PassKind::Preview(_)) && !r.from_cache)
+        .filter(|r| !r.kind.preview.is_some() && !r.from_cache)
         .collect();
     // Series in order of first appearance, each keeping its colour.
     let mut keys: Vec<SeriesKey> = Vec::new();
@@ -423,15 +427,15 @@ mod tests {
     fn series_say_what_their_passes_are() {
         let key = |octree, kind, view| SeriesKey { octree, kind, view };
         assert_eq!(
-            key(true, PassKind::OneSample, ViewMode::Shaded).name(),
+            key(true, Engine::OneSample, ViewMode::Shaded).name(),
             "octree on, 1 spp"
         );
         assert_eq!(
-            key(false, PassKind::SixteenSamples, ViewMode::Cost).name(),
+            key(false, Engine::Grid, ViewMode::Cost).name(),
             "octree off, 16 spp, cost view"
         );
         assert_eq!(
-            key(true, PassKind::Corners, ViewMode::Shaded).name(),
+            key(true, Engine::Corners, ViewMode::Shaded).name(),
             "octree on, SPD corners"
         );
     }

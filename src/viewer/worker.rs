@@ -30,7 +30,7 @@ use crate::render::{PassOptions, Renderer};
 use display::Display;
 pub use display::{DisplayBuffer, FrameSource};
 pub use job::Job;
-pub use pass_record::{PassKind, PassRecord};
+pub use pass_record::{PassRecord, ShownPass};
 
 /// The worker's record of finished passes. Previews come at up to 60 a
 /// second while the user drags, so only the newest [`Self::MAX_PREVIEWS`]
@@ -48,15 +48,12 @@ impl History {
 
     pub(super) fn push(&mut self, record: PassRecord) {
         let records = Arc::make_mut(&mut self.records);
-        if matches!(record.kind, PassKind::Preview(_)) {
+        if record.kind.preview.is_some() {
             self.previews += 1;
             if self.previews > Self::MAX_PREVIEWS {
                 // Past the cap, drop the oldest preview: one scan of a few
                 // thousand records, a few times a second.
-                if let Some(k) = records
-                    .iter()
-                    .position(|r| matches!(r.kind, PassKind::Preview(_)))
-                {
+                if let Some(k) = records.iter().position(|r| r.kind.preview.is_some()) {
                     records.remove(k);
                     self.previews -= 1;
                 }
@@ -502,7 +499,7 @@ fn show_cached(
         b.rgba = rgb_to_rgba(&frame.to_rgb8());
         b.width = frame.width;
         b.height = frame.height;
-        b.pass = Some(PassKind::of(last, None));
+        b.pass = Some(ShownPass::full(last));
         b.tiles_done = 0;
         b.tiles_total = 0;
         b.finished = true;

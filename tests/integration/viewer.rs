@@ -11,10 +11,11 @@ use common::viewer::*;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use glint::frame::rgba_to_rgb;
+use glint::render::PassKind as Engine;
 use glint::render::Renderer;
 use glint::settings::AntiAliasing;
 use glint::viewer::GlintApp;
-use glint::viewer::worker::{PassKind, Worker};
+use glint::viewer::worker::{ShownPass, Worker};
 
 #[test]
 fn toggling_octree_and_anti_aliasing_restarts_the_passes() {
@@ -223,7 +224,7 @@ fn a_drag_cancels_no_preview_and_ends_on_the_newest_camera() {
     assert!(
         h.state()
             .worker()
-            .with_buffer(|b| matches!(b.pass, Some(PassKind::Preview(_))) && b.finished)
+            .with_buffer(|b| b.pass.is_some_and(|p| p.preview.is_some()) && b.finished)
     );
     h.drop_at(start + egui::vec2(60.0, 0.0));
     h.run_steps(1);
@@ -381,7 +382,7 @@ fn protocol_spd_in_the_viewer_is_one_corner_pass() {
     assert!(h.state().worker().generation() > before, "restarted");
     settle(&mut h);
     let generation = h.state().worker().generation();
-    let kinds: Vec<PassKind> = h
+    let kinds: Vec<ShownPass> = h
         .state()
         .worker()
         .history()
@@ -391,7 +392,7 @@ fn protocol_spd_in_the_viewer_is_one_corner_pass() {
         .collect();
     assert_eq!(
         kinds,
-        vec![PassKind::Corners],
+        vec![ShownPass::full(Engine::Corners)],
         "no 16-sample pass under the protocol"
     );
     let record = h.state().worker().history().last().copied().unwrap();
@@ -424,7 +425,7 @@ fn a_budget_preview_drops_what_it_says() {
         .collect();
     assert_eq!(passes.len(), 1, "one quick pass only");
     let r = passes[0];
-    assert_eq!(r.kind, PassKind::Preview(preview));
+    assert_eq!(r.kind, ShownPass::drag_preview(preview));
     assert_eq!((r.width, r.height), (48, 36));
     assert_eq!(r.rays.primary, 48 * 36);
     assert_eq!(
@@ -457,7 +458,7 @@ fn a_budget_preview_drops_what_it_says() {
         .copied()
         .rfind(|r| r.generation == generation)
         .unwrap();
-    assert_eq!(r.kind, PassKind::Preview(one));
+    assert_eq!(r.kind, ShownPass::drag_preview(one));
     assert_eq!(r.rays, counts.rays);
     let shown: Vec<u8> = worker.with_buffer(|b| rgba_to_rgb(&b.rgba));
     assert!(

@@ -10,9 +10,10 @@ use std::time::Duration;
 use common::viewer::*;
 use glint::accel::Octree;
 use glint::frame::rgba_to_rgb;
+use glint::render::PassKind as Engine;
 use glint::render::Renderer;
 use glint::settings::AntiAliasing;
-use glint::viewer::worker::{Job, PassKind, Worker};
+use glint::viewer::worker::{Job, ShownPass, Worker};
 
 /// The worker shows each pass of the engine's plan, and the buffer it ends
 /// on is exactly the frame `glint render` writes: the tiles it swept in
@@ -26,19 +27,25 @@ fn each_plan_shows_its_passes_and_ends_on_the_cli_frame() {
             "scenes/glass.toml",
             AntiAliasing::Full,
             None,
-            vec![PassKind::OneSample, PassKind::SixteenSamples],
+            vec![
+                ShownPass::full(Engine::OneSample),
+                ShownPass::full(Engine::Grid),
+            ],
         ),
         (
             "scenes/default.toml",
             AntiAliasing::Adaptive,
             None,
-            vec![PassKind::OneSample, PassKind::SixteenSamples],
+            vec![
+                ShownPass::full(Engine::OneSample),
+                ShownPass::full(Engine::Refine),
+            ],
         ),
         (
             "scenes/spd/sizes/balls_s1.nff",
             AntiAliasing::Off,
             Some(spd),
-            vec![PassKind::Corners],
+            vec![ShownPass::full(Engine::Corners)],
         ),
     ];
     for (scene_file, aa, protocol, expected) in cases {
@@ -55,7 +62,7 @@ fn each_plan_shows_its_passes_and_ends_on_the_cli_frame() {
             .copied()
             .filter(|r| r.generation == generation)
             .collect();
-        let kinds: Vec<PassKind> = passes.iter().map(|r| r.kind).collect();
+        let kinds: Vec<ShownPass> = passes.iter().map(|r| r.kind).collect();
         assert_eq!(kinds, expected, "{scene_file}");
         let (frame, counts) = Renderer::new(&scene, &octree, settings)
             .unwrap()
@@ -172,7 +179,7 @@ fn a_new_job_cancels_the_old_one_within_a_tile() {
         worker
             .history()
             .iter()
-            .all(|r| r.generation != first || r.kind == PassKind::OneSample)
+            .all(|r| r.generation != first || r.kind == ShownPass::full(Engine::OneSample))
     );
 }
 

@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 use super::pass_cache::CachedPass;
-use super::{Job, PassKind, PassRecord, Shared};
+use super::{Job, PassRecord, Shared, ShownPass};
 use crate::camera::CameraSpec;
 use crate::frame::{Frame, resample_rgba, rgb_to_rgba};
 use crate::render::{FinishedPass, FinishedTile, PassInfo, PassWatch};
@@ -23,7 +23,7 @@ pub struct DisplayBuffer {
     /// Bumped on every change, so the UI uploads the texture only when new
     /// tiles arrived.
     pub version: u64,
-    pub pass: Option<PassKind>,
+    pub pass: Option<ShownPass>,
     /// The pass currently being rendered and its progress in tiles.
     pub tiles_done: u64,
     pub tiles_total: u64,
@@ -127,7 +127,7 @@ impl PassWatch for Display<'_> {
         }
         b.generation = self.generation;
         b.serial = self.job.serial;
-        b.pass = Some(PassKind::of(pass.kind, None));
+        b.pass = Some(ShownPass::full(pass.kind));
         b.source = Some(self.source(pass, pass.view));
         b.tiles_done = 0;
         b.tiles_total = pass.tiles;
@@ -161,7 +161,10 @@ impl PassWatch for Display<'_> {
         if let Ok(mut history) = self.shared.history.lock() {
             history.push(PassRecord {
                 generation: self.generation,
-                kind: PassKind::of(pass.info.kind, self.job.preview),
+                kind: ShownPass {
+                    pass: pass.info.kind,
+                    preview: self.job.preview,
+                },
                 seconds: summary.seconds,
                 rays: summary.counts.rays,
                 octree: self.settings.use_octree,
@@ -199,7 +202,10 @@ impl PassWatch for Display<'_> {
                 return;
             }
             b.generation = self.generation;
-            b.pass = Some(PassKind::of(pass.info.kind, self.job.preview));
+            b.pass = Some(ShownPass {
+                pass: pass.info.kind,
+                preview: self.job.preview,
+            });
             b.stopped = false;
             b.rgba = rgba;
             b.width = frame.width;

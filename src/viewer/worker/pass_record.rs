@@ -4,34 +4,48 @@
 use super::Preview;
 use crate::stats::RayCounts;
 
-/// Which pass produced a buffer.
+/// Which pass produced a buffer: one of the engine's passes
+/// ([`crate::render::PassKind`]), traced at a drag preview's reduced
+/// settings or at the frame's own.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum PassKind {
-    Preview(Preview),
-    OneSample,
-    SixteenSamples,
-    /// The SPD protocol's one pass: rays through the pixel corners.
-    Corners,
+pub struct ShownPass {
+    pub pass: crate::render::PassKind,
+    pub preview: Option<Preview>,
 }
 
-impl PassKind {
-    /// How the viewer names a pass of the library's engine.
-    pub(super) fn of(pass: crate::render::PassKind, preview: Option<Preview>) -> Self {
-        use crate::render::PassKind as Engine;
-        match (pass, preview) {
-            (_, Some(p)) => PassKind::Preview(p),
-            (Engine::OneSample, None) => PassKind::OneSample,
-            (Engine::Grid | Engine::Refine, None) => PassKind::SixteenSamples,
-            (Engine::Corners, None) => PassKind::Corners,
+impl ShownPass {
+    /// A pass at the frame's own settings.
+    pub fn full(pass: crate::render::PassKind) -> Self {
+        Self {
+            pass,
+            preview: None,
         }
     }
 
+    /// A drag preview (a 1-sample pass at reduced settings).
+    pub fn drag_preview(preview: Preview) -> Self {
+        Self {
+            pass: crate::render::PassKind::OneSample,
+            preview: Some(preview),
+        }
+    }
+
+    /// A full pass of the 4x4 grid, everywhere or where the picture needs
+    /// it (the two are one series: the same anti-aliasing, as a user sees).
+    pub fn is_grid(self) -> bool {
+        use crate::render::PassKind as Engine;
+        self.preview.is_none() && matches!(self.pass, Engine::Grid | Engine::Refine)
+    }
+
     pub fn label(self) -> String {
-        match self {
-            PassKind::Preview(p) => format!("preview {}", p.describe()),
-            PassKind::OneSample => "1 sample".into(),
-            PassKind::SixteenSamples => "16 samples".into(),
-            PassKind::Corners => "SPD corners".into(),
+        use crate::render::PassKind as Engine;
+        match (self.preview, self.pass) {
+            (Some(p), _) => format!("preview {}", p.describe()),
+            (None, Engine::OneSample) => "1 sample".into(),
+            (None, Engine::Grid | Engine::Refine) => {
+                format!("{} samples", crate::settings::AntiAliasing::SAMPLES)
+            }
+            (None, Engine::Corners) => "SPD corners".into(),
         }
     }
 }
@@ -40,7 +54,7 @@ impl PassKind {
 #[derive(Clone, Copy, Debug)]
 pub struct PassRecord {
     pub generation: u64,
-    pub kind: PassKind,
+    pub kind: ShownPass,
     pub seconds: f64,
     pub rays: RayCounts,
     pub octree: bool,

@@ -1,6 +1,7 @@
 //! Tests of `worker`.
 
 use super::*;
+use crate::render::PassKind as Engine;
 use crate::stats::RayCounts;
 
 #[test]
@@ -11,7 +12,7 @@ fn passes_describe_what_they_dropped() {
         shadows: true,
     };
     assert_eq!(
-        PassKind::Preview(preview).label(),
+        ShownPass::drag_preview(preview).label(),
         "preview 1/2, no reflections"
     );
     let one = Preview {
@@ -37,13 +38,13 @@ fn the_history_keeps_full_passes_and_the_newest_previews() {
     let record = |generation: u64, preview: bool| PassRecord {
         generation,
         kind: if preview {
-            PassKind::Preview(Preview {
+            ShownPass::drag_preview(Preview {
                 divisor: 2,
                 reflections: Reflections::Off,
                 shadows: false,
             })
         } else {
-            PassKind::OneSample
+            ShownPass::full(Engine::OneSample)
         },
         seconds: 0.01,
         rays: RayCounts::default(),
@@ -73,7 +74,7 @@ fn the_history_keeps_full_passes_and_the_newest_previews() {
     let records = &history.records;
     let fulls: Vec<u64> = records
         .iter()
-        .filter(|r| !matches!(r.kind, PassKind::Preview(_)))
+        .filter(|r| !r.kind.preview.is_some())
         .map(|r| r.generation)
         .collect();
     assert_eq!(fulls, [0, 1000, 2000, 3000, 4000]);
@@ -88,7 +89,7 @@ fn the_history_keeps_full_passes_and_the_newest_previews() {
     // 4,101 previews were pushed: the oldest 5 (generations 1 to 5) went.
     let oldest_preview = records
         .iter()
-        .find(|r| matches!(r.kind, PassKind::Preview(_)))
+        .find(|r| r.kind.preview.is_some())
         .map(|r| r.generation);
     assert_eq!(oldest_preview, Some(6));
     assert_eq!(held.map(|h| h.len()), Some(6));
