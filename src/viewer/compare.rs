@@ -66,7 +66,7 @@ pub struct Compare {
 pub fn timing_label(history: &[PassRecord], generation: u64) -> String {
     let parts: Vec<String> = history
         .iter()
-        .filter(|r| r.generation == generation && !r.kind.preview.is_some())
+        .filter(|r| r.generation == generation && r.kind.preview.is_none())
         .map(|r| format!("{} {:.3} s", r.kind.label(), r.seconds))
         .collect();
     if parts.is_empty() {

@@ -84,7 +84,7 @@ pub struct OctreeInfo<'a> {
 
 /// The last pass that was not a drag preview.
 pub fn last_full_pass(history: &[PassRecord]) -> Option<&PassRecord> {
-    history.iter().rev().find(|r| !r.kind.preview.is_some())
+    history.iter().rev().find(|r| r.kind.preview.is_none())
 }
 
 /// The prediction for the current tree and the last pass's rays.

@@ -374,7 +374,7 @@ pub fn status_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) -> Vec<
             // The buffer describes the image before until the new job's
             // first pass starts: that image is neither "done" nor the
             // progress of the new one.
-            Some((Some(pass), .., false, false)) if !pass.preview.is_some() => {
+            Some((Some(pass), .., false, false)) if pass.preview.is_none() => {
                 ui.label("starting the new image…");
             }
             Some((Some(pass), done, total, _, _, true, _)) => {

@@ -95,7 +95,7 @@ fn timing_grid_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
     let newest_record = history
         .iter()
         .rev()
-        .find(|r| !r.kind.preview.is_some())
+        .find(|r| r.kind.preview.is_none())
         .map(|r| r.generation);
     let submitted = info.worker.full_generation();
     let shown = match newest_record {
@@ -323,7 +323,7 @@ fn pass_plot_ui(history: &[PassRecord], ui: &mut egui::Ui) {
     // Passes shown again from the cache took no time now.
     let full: Vec<_> = history
         .iter()
-        .filter(|r| !r.kind.preview.is_some() && !r.from_cache)
+        .filter(|r| r.kind.preview.is_none() && !r.from_cache)
         .collect();
     // Series in order of first appearance, each keeping its colour.
     let mut keys: Vec<SeriesKey> = Vec::new();

@@ -74,7 +74,7 @@ fn the_history_keeps_full_passes_and_the_newest_previews() {
     let records = &history.records;
     let fulls: Vec<u64> = records
         .iter()
-        .filter(|r| !r.kind.preview.is_some())
+        .filter(|r| r.kind.preview.is_none())
         .map(|r| r.generation)
         .collect();
     assert_eq!(fulls, [0, 1000, 2000, 3000, 4000]);
