@@ -6,7 +6,7 @@ mod octree;
 mod primitives;
 mod walk_log;
 
-pub use crate::walk_record::{CellVisit, QueryRecord, StepKind, Tested, WalkEnd, WalkStep};
+pub use crate::stats::walk_record::{CellVisit, QueryRecord, StepKind, Tested, WalkEnd, WalkStep};
 pub use octree::{
     DEFAULT_MEMORY_BUDGET_MIB, Octree, OctreeCell, OctreeError, OctreeParams, OctreeStats,
     PacketStack, PredictedCost, WalkStack,

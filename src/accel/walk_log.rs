@@ -6,8 +6,8 @@
 //! called beside the counts they explain, so a [`WalkLog`] records the
 //! very walk the renderer does; every other counter compiles them away.
 
+use crate::stats::walk_record::{CellVisit, QueryRecord, StepKind, Tested, WalkEnd, WalkStep};
 use crate::stats::{Counter, WorkCounts};
-use crate::walk_record::{CellVisit, QueryRecord, StepKind, Tested, WalkEnd, WalkStep};
 
 /// A [`Counter`] that records each query's walk; [`Counter::take_query`]
 /// hands over the one just finished and starts the next.

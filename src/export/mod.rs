@@ -31,7 +31,7 @@ pub use record::{
 
 use crate::accel::Octree;
 use crate::camera::{Camera, CameraSpec};
-use crate::frame::Frame;
+use crate::image::frame::Frame;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 
@@ -82,7 +82,8 @@ pub fn save_frame(
         Some(o) => {
             record.settings.overlay_depth = Some(o.depth);
             let cells = o.octree.cells(o.depth);
-            let (rgb, height) = crate::overlay::annotate(frame, o.camera, &cells, o.depth, legend);
+            let (rgb, height) =
+                crate::image::overlay::annotate(frame, o.camera, &cells, o.depth, legend);
             save_rgb_png(path, frame.width, height, &rgb, Some(record))
         }
         None if legend => save_png(frame, path, Some(record)),

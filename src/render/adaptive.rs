@@ -11,7 +11,7 @@
 //! differ), here with the regular grid glint uses everywhere.
 
 use crate::math::Color;
-use crate::ray_tree::{RayKind, RayRecorder};
+use crate::render::ray_tree::{RayKind, RayRecorder};
 
 /// Largest difference, in 8-bit display steps on any channel, between
 /// neighbouring centre samples that still counts as smooth. Measured on

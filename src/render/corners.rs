@@ -9,7 +9,7 @@ use std::sync::{Arc, Mutex};
 
 use rayon::prelude::*;
 
-use crate::frame::TileEncoder;
+use crate::image::frame::TileEncoder;
 use crate::math::DVec3;
 use crate::stats::RenderCounts;
 

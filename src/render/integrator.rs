@@ -5,7 +5,7 @@
 
 use crate::accel::ClosestHit;
 use crate::math::{Color, DVec3, Ray, offset_ray_origin, reflect, refract};
-use crate::ray_tree::{HitRecord, RayKind, RayRecorder, ShadowRecord, ShadowVerdict};
+use crate::render::ray_tree::{HitRecord, RayKind, RayRecorder, ShadowRecord, ShadowVerdict};
 use crate::settings::Protocol;
 use crate::shapes::{PreparedRay, Shape};
 use crate::stats::{Counter, RayCounts};

@@ -13,6 +13,7 @@ mod integrator;
 pub mod memory;
 mod packets;
 mod passes;
+pub mod ray_tree;
 mod sampling;
 mod tile_job;
 pub mod tiles;
@@ -34,7 +35,7 @@ pub use unit_costs::{
 mod tests {
     use super::*;
     use crate::camera::CameraSpec;
-    use crate::frame::Frame;
+    use crate::image::frame::Frame;
     use crate::limits::{LimitError, MAX_IMAGE_SIDE};
     use crate::material::Light;
     use crate::material::Material;

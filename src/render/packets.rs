@@ -13,7 +13,7 @@
 
 use crate::accel::{ClosestHit, PacketStack, Primitives, ShadowCrossings};
 use crate::math::{Color, DVec3, Ray};
-use crate::ray_tree::{NoRecord, RayRecorder};
+use crate::render::ray_tree::{NoRecord, RayRecorder};
 use crate::shapes::{PacketHits, PreparedRay, RayPacket, ShapeHit};
 use crate::simd::{LaneWork, splat};
 use crate::stats::{Counter, NoCounts, RayCounts, RenderCounts};

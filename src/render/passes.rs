@@ -13,9 +13,9 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
-use crate::frame::{Frame, TileEncoder};
+use crate::image::frame::{Frame, TileEncoder};
+use crate::image::metrics::ImageError;
 use crate::math::DVec3;
-use crate::metrics::ImageError;
 use crate::settings::{AntiAliasing, RenderSettings, ViewMode};
 use crate::stats::RenderCounts;
 
@@ -145,7 +145,7 @@ impl<'a> FinishedTile<'a> {
         let Some(values) = self.values else {
             return false;
         };
-        let bytes = crate::frame::rgb_to_rgba(&self.encoder.rgb(values));
+        let bytes = crate::image::frame::rgb_to_rgba(&self.encoder.rgb(values));
         place_tile(rgba, width, &self.tile, &bytes, 4);
         true
     }
@@ -340,7 +340,7 @@ impl Renderer<'_> {
                     .as_ref()
                     .filter(|_| options.progressive && refines)
                     .map(|one| {
-                        crate::metrics::image_error(&one.frame.pixels, &frame.pixels, colors)
+                        crate::image::metrics::image_error(&one.frame.pixels, &frame.pixels, colors)
                     }),
             };
             total += counts;

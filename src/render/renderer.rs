@@ -11,7 +11,7 @@ use crate::camera::{Camera, CameraError, CameraSpec, sample_offsets};
 use crate::limits::LimitError;
 use crate::material::Material;
 use crate::math::Color;
-use crate::ray_tree::{RayKind, RayNode};
+use crate::render::ray_tree::{RayKind, RayNode};
 use crate::scene::Scene;
 use crate::settings::{RenderSettings, Sides, ViewMode};
 use crate::shapes::PreparedRay;

@@ -4,7 +4,7 @@
 //! packets of rays where the scene allows it and one ray at a time elsewhere.
 
 use crate::math::{DVec3, Ray};
-use crate::ray_tree::{NoRecord, RayRecorder};
+use crate::render::ray_tree::{NoRecord, RayRecorder};
 use crate::settings::ViewMode;
 use crate::shapes::PreparedRay;
 use crate::stats::{Counter, NoCounts, RayCounts, RenderCounts, WorkCounts};

@@ -7,7 +7,7 @@ use super::state::SceneSource;
 use super::worker::Worker;
 use crate::accel::Octree;
 use crate::export::{OverlayRequest, RenderRecord, SceneEdits, save_frame};
-use crate::frame::rgba_to_rgb;
+use crate::image::frame::rgba_to_rgb;
 
 /// The path to export to: chosen in a save dialog, or, where no dialog is
 /// available, a timestamped name in a place made for pictures. `None` when

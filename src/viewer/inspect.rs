@@ -114,9 +114,9 @@ impl InspectState {
         let painter = ui.painter_at(image_rect);
         if let Some(depth) = self.overlay_depth {
             let cells = self.overlay_cells(octree, depth);
-            for (cell, color) in crate::overlay::styled_cells(&cells) {
+            for (cell, color) in crate::image::overlay::styled_cells(&cells) {
                 let color = color32(color);
-                for (a, b) in crate::overlay::cell_segments(&camera, cell) {
+                for (a, b) in crate::image::overlay::cell_segments(&camera, cell) {
                     painter.line_segment(
                         [
                             to_screen(image_rect, w, h, a),
@@ -131,7 +131,9 @@ impl InspectState {
             {
                 let x = (pos.x - image_rect.min.x) / image_rect.width() * w as f32;
                 let y = (pos.y - image_rect.min.y) / image_rect.height() * h as f32;
-                if let Some(cell) = crate::overlay::cell_at(&camera, &cells, x as f64, y as f64) {
+                if let Some(cell) =
+                    crate::image::overlay::cell_at(&camera, &cells, x as f64, y as f64)
+                {
                     let b = cell.bounds;
                     let text = format!(
                         "depth {}\nbounds ({:.3}, {:.3}, {:.3})\n  to ({:.3}, {:.3}, {:.3})\nreferences {}",

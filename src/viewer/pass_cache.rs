@@ -6,7 +6,7 @@ use std::sync::{Arc, Weak};
 
 use crate::accel::Octree;
 use crate::camera::CameraSpec;
-use crate::frame::Frame;
+use crate::image::frame::Frame;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 

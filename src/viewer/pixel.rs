@@ -7,7 +7,7 @@ use super::state::EditState;
 use crate::accel::Octree;
 use crate::camera::Camera;
 use crate::math::DVec3;
-use crate::ray_tree::{RayKind, RayNode, ShadowVerdict};
+use crate::render::ray_tree::{RayKind, RayNode, ShadowVerdict};
 use crate::render::{RenderError, Renderer};
 use crate::settings::{RenderSettings, ViewMode};
 
@@ -109,7 +109,7 @@ fn segment(
     b: DVec3,
     stroke: Stroke,
 ) {
-    if let Some((p, q)) = crate::overlay::project_segment(camera, a, b) {
+    if let Some((p, q)) = crate::image::overlay::project_segment(camera, a, b) {
         let (w, h) = (camera.width(), camera.height());
         painter.line_segment(
             [

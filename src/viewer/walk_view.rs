@@ -9,7 +9,7 @@ use super::pixel::{Inspection, WalkTarget, to_screen};
 use crate::accel::{QueryRecord, StepKind, WalkEnd, WalkStep};
 use crate::camera::Camera;
 use crate::math::DVec3;
-use crate::ray_tree::RayNode;
+use crate::render::ray_tree::RayNode;
 
 /// The walk being stepped through.
 #[derive(Clone, Debug)]
@@ -263,12 +263,12 @@ pub fn draw_walk(
             depth: step.depth.unwrap_or(0),
             references: 0,
         };
-        for (a, b) in crate::overlay::cell_segments(camera, &cell) {
+        for (a, b) in crate::image::overlay::cell_segments(camera, &cell) {
             line(a, b, stroke);
         }
         if current
             && let (Some(t0), Some(t1)) = (step.t_enter, step.t_exit)
-            && let Some((a, b)) = crate::overlay::project_segment(
+            && let Some((a, b)) = crate::image::overlay::project_segment(
                 camera,
                 ray.origin + t0 * ray.direction,
                 ray.origin + t1 * ray.direction,

@@ -25,7 +25,7 @@ mod display;
 mod job;
 mod pass_record;
 
-use crate::frame::{Frame, rgb_to_rgba};
+use crate::image::frame::{Frame, rgb_to_rgba};
 use crate::render::{PassOptions, Renderer};
 use display::Display;
 pub use display::{DisplayBuffer, FrameSource};

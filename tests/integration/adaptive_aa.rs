@@ -5,7 +5,7 @@
 use crate::common;
 
 use glint::accel::Octree;
-use glint::frame::Frame;
+use glint::image::frame::Frame;
 use glint::render::Renderer;
 use glint::scene::Scene;
 use glint::settings::AntiAliasing;
@@ -61,8 +61,9 @@ fn adaptive_is_within_45_db_of_the_full_grid_on_every_scene_kind() {
         let (full, _) = render(&scene, &octree, AntiAliasing::Full, 200, 150);
         let (adaptive, refined) = render(&scene, &octree, AntiAliasing::Adaptive, 200, 150);
         let (off, _) = render(&scene, &octree, AntiAliasing::Off, 200, 150);
-        let psnr = |image: &glint::frame::Frame| {
-            glint::metrics::image_error(&image.pixels, &full.pixels, full.colors).psnr_display
+        let psnr = |image: &glint::image::frame::Frame| {
+            glint::image::metrics::image_error(&image.pixels, &full.pixels, full.colors)
+                .psnr_display
         };
         let db = psnr(&adaptive);
         eprintln!(

@@ -5,11 +5,11 @@ use crate::common;
 
 use std::process::Command;
 
-use glint::frame::Frame;
+use glint::image::frame::Frame;
+use glint::image::metrics::image_error;
 use glint::math::DVec3;
-use glint::metrics::image_error;
-use glint::ray_tree::{RayKind, RayNode};
 use glint::render::Renderer;
+use glint::render::ray_tree::{RayKind, RayNode};
 use glint::scene::Scene;
 use glint::settings::{RenderSettings, ViewMode};
 

@@ -7,8 +7,8 @@ use crate::common;
 use common::{repo_path, scene_from};
 use glint::color::ColorConvention;
 use glint::math::DVec3;
-use glint::ray_tree::{RayKind, RayNode};
 use glint::render::Renderer;
+use glint::render::ray_tree::{RayKind, RayNode};
 use glint::scene::Scene;
 use glint::settings::{Protocol, RenderSettings, ViewMode};
 

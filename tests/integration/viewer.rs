@@ -10,7 +10,7 @@ use std::time::Duration;
 use common::viewer::*;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
-use glint::frame::rgba_to_rgb;
+use glint::image::frame::rgba_to_rgb;
 use glint::render::PassKind as Engine;
 use glint::render::Renderer;
 use glint::settings::AntiAliasing;

@@ -9,7 +9,7 @@ use std::time::Duration;
 
 use common::viewer::*;
 use glint::accel::Octree;
-use glint::frame::rgba_to_rgb;
+use glint::image::frame::rgba_to_rgb;
 use glint::render::PassKind as Engine;
 use glint::render::Renderer;
 use glint::settings::AntiAliasing;

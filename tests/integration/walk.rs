@@ -5,8 +5,8 @@
 use crate::common;
 
 use glint::accel::{QueryRecord, StepKind, WalkEnd};
-use glint::ray_tree::{RayNode, ShadowVerdict};
 use glint::render::Renderer;
+use glint::render::ray_tree::{RayNode, ShadowVerdict};
 use glint::scene::Scene;
 use glint::settings::RenderSettings;
 use glint::simd::SimdLevel;

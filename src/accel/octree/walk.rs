@@ -10,7 +10,7 @@ use crate::accel::primitives::{
 use crate::limits::MAX_OCTREE_DEPTH;
 use crate::shapes::PreparedRay;
 use crate::stats::Counter;
-use crate::walk_record::{CellVisit, StepKind, WalkEnd};
+use crate::stats::walk_record::{CellVisit, StepKind, WalkEnd};
 
 impl Octree {
     /// Closest hit with `0 < t < t_max`; `stack` is the caller's scratch.

@@ -137,7 +137,7 @@ struct SceneBench {
     /// The SPD's published counts for this scene (default SPD scenes at
     /// 512x512 under `--protocol spd` only).
     #[serde(skip_serializing_if = "Option::is_none")]
-    published: Option<glint::published::SpdCounts>,
+    published: Option<glint::stats::published::SpdCounts>,
 }
 
 fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
@@ -298,7 +298,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             protocol: settings.protocol,
             published: (settings.protocol == glint::settings::Protocol::Spd
                 && (settings.width, settings.height) == (512, 512))
-                .then(|| glint::published::spd_counts(&stem(path)))
+                .then(|| glint::stats::published::spd_counts(&stem(path)))
                 .flatten(),
         });
     }
@@ -338,8 +338,9 @@ fn markdown(results: &[SceneBench]) -> String {
             Some(off) => format!("{:.2}", off.render_s),
         };
         let speedup = r.speedup.map_or("–".to_string(), |x| format!("{x:.1}x"));
-        let havran = glint::published::havran_best_nit(&stem(std::path::Path::new(&r.scene)))
-            .map_or("".to_string(), |x| format!("{x:.2}"));
+        let havran =
+            glint::stats::published::havran_best_nit(&stem(std::path::Path::new(&r.scene)))
+                .map_or("".to_string(), |x| format!("{x:.2}"));
         s.push_str(&format!(
             "| {} | {} | {}x{} | {} | {:.3} | {:.3} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {:.2}x |\n",
             name,

@@ -122,7 +122,7 @@ struct TraceJson<'a> {
     color: [f64; 3],
     srgb8: [u8; 3],
     lights: Vec<LightJson>,
-    tree: &'a glint::ray_tree::RayNode,
+    tree: &'a glint::render::ray_tree::RayNode,
 }
 
 #[derive(Serialize)]
@@ -380,7 +380,11 @@ impl PassWatch for ProgressBar<'_> {
 }
 
 /// Writes the frame with its record (and the overlay, if asked for).
-fn save(job: &Prepared, frame: &glint::frame::Frame, output: &std::path::Path) -> Result<()> {
+fn save(
+    job: &Prepared,
+    frame: &glint::image::frame::Frame,
+    output: &std::path::Path,
+) -> Result<()> {
     let s = &job.settings;
     let mut record = glint::export::RenderRecord::new(&job.scene, &job.scene_name, &job.camera, *s);
     record.settings.legend = job.legend;

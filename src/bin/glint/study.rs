@@ -11,9 +11,9 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use glint::accel::{Octree, OctreeParams};
-use glint::frame::Frame;
+use glint::image::frame::Frame;
+use glint::image::metrics::image_error;
 use glint::math::DVec3;
-use glint::metrics::image_error;
 use glint::render::Renderer;
 use glint::scene::Scene;
 use glint::settings::RenderSettings;

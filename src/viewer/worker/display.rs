@@ -8,7 +8,7 @@ use std::time::Instant;
 use super::pass_cache::CachedPass;
 use super::{Job, PassRecord, Shared, ShownPass};
 use crate::camera::CameraSpec;
-use crate::frame::{Frame, resample_rgba, rgb_to_rgba};
+use crate::image::frame::{Frame, resample_rgba, rgb_to_rgba};
 use crate::render::{FinishedPass, FinishedTile, PassInfo, PassWatch};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;

@@ -65,7 +65,7 @@ pub struct PassRecord {
     pub finished_at: f64,
     /// For a 16-sample pass: the error of the same generation's 1-sample
     /// pass against it (what anti-aliasing changed).
-    pub one_sample_error: Option<crate::metrics::ImageError>,
+    pub one_sample_error: Option<crate::image::metrics::ImageError>,
     /// For an adaptive 16-sample pass: the pixels it refined (the rest kept
     /// their 1-sample value).
     pub refined_pixels: Option<u64>,

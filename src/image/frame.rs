@@ -172,7 +172,9 @@ impl TileEncoder {
                 };
                 values
                     .iter()
-                    .flat_map(|v| crate::legend::viridis(cost_shade(cost_value(*v, view), range)))
+                    .flat_map(|v| {
+                        crate::image::legend::viridis(cost_shade(cost_value(*v, view), range))
+                    })
                     .collect()
             }
             ViewMode::Depth => {
@@ -231,7 +233,7 @@ impl Frame {
                 ViewMode::Normals => [p.x, p.y, p.z].map(to_byte),
                 ViewMode::Depth => [to_byte(depth_shade(*p, near.unwrap_or(0.0))); 3],
                 ViewMode::Cost | ViewMode::CostSteps => {
-                    crate::legend::viridis(cost_shade(cost_value(*p, self.view), range))
+                    crate::image::legend::viridis(cost_shade(cost_value(*p, self.view), range))
                 }
                 ViewMode::AaNeed => [p.x, p.y, p.z].map(|c| to_byte(c * AA_NEED_GAIN)),
             }
@@ -287,8 +289,8 @@ impl Frame {
 
     /// What the legend strip of a diagnostic view says (none for the
     /// pictures that explain themselves).
-    pub fn legend(&self) -> Option<crate::legend::Legend> {
-        use crate::legend::{Legend, Ramp};
+    pub fn legend(&self) -> Option<crate::image::legend::Legend> {
+        use crate::image::legend::{Legend, Ramp};
         match self.view {
             ViewMode::Cost | ViewMode::CostSteps => {
                 let c = self.cost_summary()?;
@@ -346,7 +348,7 @@ impl Frame {
         let mut rgb = self.to_rgb8();
         let height = match self.legend() {
             Some(legend) => {
-                crate::legend::append_legend(&mut rgb, self.width, self.height, &legend)
+                crate::image::legend::append_legend(&mut rgb, self.width, self.height, &legend)
             }
             None => self.height,
         };

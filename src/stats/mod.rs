@@ -2,7 +2,10 @@
 //! every increment compiles to nothing, so counting costs only when asked for.
 //! [`RenderCounts`] gathers what a render counted, tile by tile and in all.
 
-use crate::walk_record::{CellVisit, QueryRecord, WalkEnd};
+pub mod published;
+pub mod walk_record;
+
+use walk_record::{CellVisit, QueryRecord, WalkEnd};
 
 /// Receives one call per unit of work done for a ray.
 pub trait Counter {

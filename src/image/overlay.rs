@@ -3,7 +3,7 @@
 
 use crate::accel::OctreeCell;
 use crate::camera::Camera;
-use crate::legend::viridis;
+use crate::image::legend::viridis;
 use crate::math::{DVec3, Ray};
 
 /// Colour of a cell holding `references` when the fullest holds `most`:
@@ -122,7 +122,7 @@ pub fn draw_cells(rgb: &mut [u8], camera: &Camera, cells: &[OctreeCell]) {
 /// own, or else the overlay's colour scale). Returns the bytes and the
 /// height.
 pub fn annotate(
-    frame: &crate::frame::Frame,
+    frame: &crate::image::frame::Frame,
     camera: &Camera,
     cells: &[OctreeCell],
     depth: u32,
@@ -135,14 +135,14 @@ pub fn annotate(
     }
     let legend = frame.legend().unwrap_or_else(|| {
         let most = cells.iter().map(|c| c.references).max().unwrap_or(0);
-        crate::legend::Legend {
+        crate::image::legend::Legend {
             low: "1".into(),
             high: most.to_string(),
             caption: format!("octree to depth {depth}: refs per cell (log)"),
-            ramp: crate::legend::Ramp::Viridis,
+            ramp: crate::image::legend::Ramp::Viridis,
         }
     });
-    let height = crate::legend::append_legend(&mut rgb, frame.width, frame.height, &legend);
+    let height = crate::image::legend::append_legend(&mut rgb, frame.width, frame.height, &legend);
     (rgb, height)
 }
 

@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use crate::math::{Color, Ray};
 use crate::shapes::ShapeKind;
-use crate::walk_record::QueryRecord;
+use crate::stats::walk_record::QueryRecord;
 
 /// Why a ray was cast.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
