@@ -13,6 +13,7 @@ mod obj;
 mod obj_scene;
 pub mod polygon;
 pub mod save;
+mod text;
 pub mod toml_format;
 
 use std::path::Path;

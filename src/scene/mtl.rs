@@ -49,10 +49,11 @@ const IGNORED: [&str; 2] = ["Ka", "sharpness"];
 /// Parses an MTL file: its materials in order.
 pub(super) fn parse(bytes: &[u8]) -> Result<Vec<MtlEntry>, ObjError> {
     let mut entries: Vec<MtlEntry> = Vec::new();
-    for (index, raw) in bytes.split(|&b| b == b'\n').enumerate() {
+    let text = super::text::utf8_text(bytes);
+    for (index, raw) in text.split(|&b| b == b'\n').enumerate() {
         let line = index + 1;
         let err = |message: String| ObjError { line, message };
-        let content = match raw.iter().position(|&b| b == b'#') {
+        let content = match super::text::comment_start(raw).map_err(err)? {
             Some(hash) => &raw[..hash],
             None => raw,
         }

@@ -134,12 +134,13 @@ pub(super) fn parse(bytes: &[u8]) -> Result<ObjData, ObjError> {
     // Positive indices may point forward (some exporters write faces
     // first); they are checked once every vertex is known.
     let mut last_line_of_face: Vec<usize> = Vec::new();
-    for (number, line) in logical_lines(bytes) {
+    let text = super::text::utf8_text(bytes);
+    for (number, line) in logical_lines(&text) {
         let err = |message: String| ObjError {
             line: number,
             message,
         };
-        let content = match line.iter().position(|&b| b == b'#') {
+        let content = match super::text::comment_start(&line).map_err(&err)? {
             Some(hash) => &line[..hash],
             None => &line[..],
         };

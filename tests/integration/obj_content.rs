@@ -385,3 +385,68 @@ fn an_obj_whose_faces_all_lack_area_is_refused_like_one_without_faces() {
     let scene = load_file(&d.join("some.obj"));
     assert_eq!(scene.shapes.len(), 1);
 }
+
+/// Windows tools' encodings read as their text: a UTF-8 byte-order mark
+/// or UTF-16 (either byte order, with its mark) gives the same scene as
+/// plain UTF-8, in the OBJ and in its MTL; MSVC's printed NaN is refused
+/// with the file and line, not read as -1.
+#[test]
+fn byte_order_marks_utf16_and_msvc_nan() {
+    let dir = temp_dir();
+    write(dir.path(), "two.obj", TWO_QUADS.as_bytes());
+    let mtl = "newmtl left\nKd 1 0 0\nillum 1\nnewmtl right\nKd 0 1 0\nillum 1\n";
+    write(dir.path(), "two.mtl", mtl.as_bytes());
+    let plain = load_file(&dir.path().join("two.obj"));
+    let utf16 = |text: &str, big_endian: bool| {
+        let mut bytes = if big_endian {
+            vec![0xFE, 0xFF]
+        } else {
+            vec![0xFF, 0xFE]
+        };
+        for unit in text.encode_utf16() {
+            bytes.extend(if big_endian {
+                unit.to_be_bytes()
+            } else {
+                unit.to_le_bytes()
+            });
+        }
+        bytes
+    };
+    let bom = |text: &str| [&[0xEF, 0xBB, 0xBF][..], text.as_bytes()].concat();
+    for (obj, lib) in [
+        (bom(TWO_QUADS), bom(mtl)),
+        (utf16(TWO_QUADS, false), utf16(mtl, false)),
+        (utf16(TWO_QUADS, true), utf16(mtl, true)),
+    ] {
+        write(dir.path(), "two.obj", &obj);
+        write(dir.path(), "two.mtl", &lib);
+        let scene = load_file(&dir.path().join("two.obj"));
+        assert_eq!(scene.shapes, plain.shapes);
+        assert_eq!(scene.materials, plain.materials);
+        assert_eq!(scene.load_notes, plain.load_notes);
+    }
+    write(
+        dir.path(),
+        "nan.obj",
+        b"v 0 0 0\nv 1 0 0\nv -1.#IND00 1 0\nf 1 2 3\n",
+    );
+    let message = glint::scene::load(&dir.path().join("nan.obj"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("nan.obj")
+            && message.contains("line 3")
+            && message.contains("`-1.#IND00` is not a number"),
+        "{message}"
+    );
+    write(dir.path(), "two.obj", TWO_QUADS.as_bytes());
+    write(dir.path(), "two.mtl", b"newmtl left\nKd 1.#QNAN 0 0\n");
+    // A library that cannot be read is a note (its materials fall back to
+    // the default), naming its file and line.
+    let scene = load_file(&dir.path().join("two.obj"));
+    assert!(
+        scene.load_notes[0].contains("two.mtl: line 2: `1.#QNAN` is not a number"),
+        "{:?}",
+        scene.load_notes
+    );
+}
