@@ -46,7 +46,12 @@ pub(super) fn read_libraries(
             };
             match files.read(&path) {
                 Ok(bytes) => match mtl::parse(&bytes) {
-                    Ok(mut found) => entries.append(&mut found),
+                    Ok(mut found) => {
+                        for entry in &mut found {
+                            entry.library.clone_from(&path);
+                        }
+                        entries.append(&mut found)
+                    }
                     Err(e) => notes.push(format!(
                         "{}: {e}; its materials are shown in the default material",
                         path.display()
@@ -119,6 +124,9 @@ pub(super) fn mesh_materials(
             .flatten();
         let index = match entry {
             Some(e) if used[slot] => {
+                if let (_, Some(note)) = e.opacity() {
+                    scene.load_notes.push(note);
+                }
                 let clamped = e.clamped();
                 if !clamped.is_empty() {
                     scene.load_notes.push(format!(

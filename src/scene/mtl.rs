@@ -3,10 +3,11 @@
 //!
 //! | MTL | glint |
 //! |---|---|
-//! | `Kd` | `color` (clamped to [0, 1]), with `kd = 1` |
-//! | `Ks` | `ks` = mean of `Ks` where the `illum` model has a highlight (2 to 9) |
-//! | `Ns` | `shininess` |
-//! | `d`, `Tr` (= 1 - `d`) | `transparency = 1 - d` |
+//! | `Kd` | `color` (clamped to [0, 1]), with `kd = d` |
+//! | `Ks` | `ks` = `d` x mean of `Ks` where the `illum` model has a highlight (2 to 9) |
+//! | `Ns` | `shininess`; below 1 no highlight (`ks = 0`): Blender writes `Ns 0` for a fully rough surface, 3ds Max for glossiness 0; a negative `Ns` gets a note |
+//! | `d` (dissolve) | a blend: the surface terms (`ka`, `kd`, `ks`) scaled by `d`, `transparency = 1 - d` straight through (refracting only for `illum 6, 7`), so `d 0` shows what lies behind |
+//! | `Tr` | `1 - d` where no `d` is written (`d` wins, with a note, when both are and disagree); `Tr 1` alone, which would make the material invisible, is read as opaque (MeshLab and others write it meaning opaque), with a note |
 //! | `Tf` | `transparency` = mean of `Tf` for refracting models (6, 7) when `d` is 1 |
 //! | `Ni` | `ior` for refracting models (6, 7), brought within 0.01 to 100 with a load note; `illum 4` and `9` are glass without refraction (`ior = 1`) |
 //! | `illum 0, 1` | diffuse only (`ks = 0`); 0 also without ambient (`ka = 0`) |
@@ -34,8 +35,12 @@ pub(super) struct MtlEntry {
     pub tf: Option<Color>,
     pub ns: Option<f64>,
     pub ni: Option<f64>,
-    /// Opacity, from `d` or `1 - Tr` (the last one written wins).
-    pub d: Option<f64>,
+    /// `d` (dissolve, the opacity) and `Tr` as written, each with its
+    /// line: [`MtlEntry::opacity`] reads them together.
+    pub d: Option<(f64, usize)>,
+    pub tr: Option<(f64, usize)>,
+    /// The library file the entry is in, for notes.
+    pub library: std::path::PathBuf,
     pub illum: Option<u32>,
     /// Keywords glint does not render, as written (`map_Kd`, `bump`, ...).
     pub not_rendered: BTreeSet<String>,
@@ -136,8 +141,8 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Vec<MtlEntry>, ObjError> {
             },
             "Ns" => entry.ns = Some(one()?),
             "Ni" => entry.ni = Some(one()?),
-            "d" => entry.d = Some(one()?),
-            "Tr" => entry.d = Some(1.0 - one()?),
+            "d" => entry.d = Some((one()?, line)),
+            "Tr" => entry.tr = Some((one()?, line)),
             "illum" => {
                 let i = one()?;
                 if !(0.0..=10.0).contains(&i) || i.fract() != 0.0 {
@@ -171,7 +176,7 @@ impl MtlEntry {
         let ks = self.ks.map_or(0.0, |c| unit(mean(c)));
         let reflects = matches!(illum, 3..=9);
         let refracts = matches!(illum, 6 | 7);
-        let opacity = unit(self.d.unwrap_or(1.0));
+        let opacity = unit(self.opacity().0);
         let mut transparency = 1.0 - opacity;
         if refracts && opacity == 1.0 {
             transparency = self.tf.map_or(1.0, |c| unit(mean(c)));
@@ -184,11 +189,16 @@ impl MtlEntry {
             color: self.kd.map_or(Material::default().color, |c| {
                 c.clamp(DVec3::ZERO, DVec3::ONE)
             }),
-            ka: if illum == 0 { 0.0 } else { 1.0 },
-            kd: 1.0,
-            ks: if matches!(illum, 0 | 1 | 10) { 0.0 } else { ks },
+            // Dissolve blends the surface with what lies behind it.
+            ka: if illum == 0 { 0.0 } else { opacity },
+            kd: opacity,
+            ks: if matches!(illum, 0 | 1 | 10) || self.ns.is_some_and(|n| n < 1.0) {
+                0.0
+            } else {
+                opacity * ks
+            },
             shininess: self.ns.map_or(Material::default().shininess, |n| {
-                n.clamp(0.0, *crate::limits::SHININESS_RANGE.end())
+                n.clamp(1.0, *crate::limits::SHININESS_RANGE.end())
             }),
             reflectivity,
             transparency,
@@ -227,11 +237,48 @@ impl MtlEntry {
         }
         if let Some(n) = self.ns {
             let hi = *crate::limits::SHININESS_RANGE.end();
-            if !(0.0..=hi).contains(&n) {
-                out.push(format!("Ns {n} used as {}", n.clamp(0.0, hi)));
+            if n < 0.0 {
+                out.push(format!("Ns {n} used as no highlight"));
+            } else if n > hi {
+                out.push(format!("Ns {n} used as {hi}"));
             }
         }
         out
+    }
+
+    /// The opacity `d` and `Tr` say together, and a note where reading
+    /// them took a choice: `d` is the standard key and wins over a `Tr`
+    /// that disagrees (3ds Max writes `d 1` then `Tr 1`, meaning opaque);
+    /// `Tr` alone is `1 - d`, except that a `Tr` making the material fully
+    /// invisible is read as opaque (MeshLab and others write `Tr 1` for
+    /// opaque; an invisible material would be pointless to export).
+    pub fn opacity(&self) -> (f64, Option<String>) {
+        let at = |line: usize| format!("{}: line {line}", self.library.display());
+        match (self.d, self.tr) {
+            (Some((d, d_line)), Some((tr, tr_line))) => {
+                let note = (1.0 - tr != d).then(|| {
+                    format!(
+                        "{}: material `{}` has `d {d}` and `Tr {tr}` (line {tr_line}), which \
+                         disagree: `d` is the standard key, opacity {d} used",
+                        at(d_line),
+                        self.name
+                    )
+                });
+                (d, note)
+            }
+            (Some((d, _)), None) => (d, None),
+            (None, Some((tr, line))) if tr >= 1.0 => (
+                1.0,
+                Some(format!(
+                    "{}: material `{}` has `Tr {tr}` alone, which would make it invisible: \
+                     read as opaque, as MeshLab and other exporters mean it",
+                    at(line),
+                    self.name
+                )),
+            ),
+            (None, Some((tr, _))) => (1.0 - tr, None),
+            (None, None) => (1.0, None),
+        }
     }
 }
 

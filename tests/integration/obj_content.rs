@@ -450,3 +450,94 @@ fn byte_order_marks_utf16_and_msvc_nan() {
         scene.load_notes
     );
 }
+
+/// A grey quad in front of a red one, with `front`'s MTL lines.
+fn dissolve_scene(dir: &Path, front: &str) -> Scene {
+    write(
+        dir,
+        "layers.obj",
+        b"mtllib layers.mtl\n\
+          v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n\
+          v -3 -3 -1\nv 3 -3 -1\nv 3 3 -1\nv -3 3 -1\n\
+          usemtl front\nf 1 2 3 4\nusemtl back\nf 5 6 7 8\n",
+    );
+    write(
+        dir,
+        "layers.mtl",
+        format!("newmtl front\nKd 0.5 0.5 0.5\n{front}\nnewmtl back\nKd 1 0 0\nillum 1\n")
+            .as_bytes(),
+    );
+    let toml = dir.join("scene.toml");
+    std::fs::write(&toml, facing_scene("layers.obj", "")).unwrap();
+    load_file(&toml)
+}
+
+/// MTL's dissolve blends the surface with what lies behind it: `d 0`
+/// shows the red quad behind exactly as if the grey one were not there,
+/// and the grey quad never brightens as `d` falls. `d` wins over a `Tr`
+/// that disagrees and `Tr 1` alone reads as opaque, each with a note
+/// naming the library and line; `Ns 0` (Blender's fully rough) is no
+/// highlight, so `Ks 0.9` does not wash out `Kd`.
+#[test]
+fn mtl_dissolve_tr_and_ns_mean_what_exporters_mean() {
+    let dir = temp_dir();
+    let centre = |scene: &Scene| pixel(&render(scene, 40, 40, 1), 40, 20, 20);
+    let behind = centre(&dissolve_scene(dir.path(), "d 0\nillum 1"));
+    write(
+        dir.path(),
+        "alone.obj",
+        b"mtllib layers.mtl\nv -3 -3 -1\nv 3 -3 -1\nv 3 3 -1\nv -3 3 -1\nusemtl back\nf 1 2 3 4\n",
+    );
+    let toml = dir.path().join("alone.toml");
+    std::fs::write(&toml, facing_scene("alone.obj", "")).unwrap();
+    assert_eq!(
+        behind,
+        centre(&load_file(&toml)),
+        "d 0 shows what lies behind"
+    );
+    let mut last = behind;
+    for d in [0.25, 0.5, 0.75, 1.0] {
+        let seen = centre(&dissolve_scene(dir.path(), &format!("d {d}\nillum 1")));
+        // The grey quad's share (the green channel: the red quad has
+        // none) grows as it becomes opaque; before, it was full at any d.
+        assert!(seen[1] > last[1], "d {d}: {seen:?} after {last:?}");
+        last = seen;
+    }
+    assert_eq!(last[0], last[1], "d 1 is the grey quad alone");
+
+    let both = dissolve_scene(dir.path(), "d 1\nTr 1\nillum 1");
+    assert_eq!(centre(&both), last, "d wins: opaque");
+    assert!(
+        both.load_notes
+            .iter()
+            .any(|n| n.contains("layers.mtl: line 3") && n.contains("disagree")),
+        "{:?}",
+        both.load_notes
+    );
+    let tr = dissolve_scene(dir.path(), "Tr 1\nillum 1");
+    assert_eq!(centre(&tr), last, "Tr 1 alone: opaque");
+    assert!(
+        tr.load_notes
+            .iter()
+            .any(|n| n.contains("layers.mtl: line 3") && n.contains("read as opaque")),
+        "{:?}",
+        tr.load_notes
+    );
+    assert_eq!(
+        centre(&dissolve_scene(dir.path(), "Tr 0.75\nillum 1")),
+        centre(&dissolve_scene(dir.path(), "d 0.25\nillum 1"))
+    );
+
+    let rough = dissolve_scene(dir.path(), "Ks 0.9 0.9 0.9\nNs 0\nillum 2");
+    assert_eq!(centre(&rough), last, "Ns 0: Kd as without a highlight");
+    let negative = dissolve_scene(dir.path(), "Ks 0.9 0.9 0.9\nNs -5\nillum 2");
+    assert_eq!(centre(&negative), last);
+    assert!(
+        negative
+            .load_notes
+            .iter()
+            .any(|n| n.contains("Ns -5 used as no highlight")),
+        "{:?}",
+        negative.load_notes
+    );
+}
