@@ -2,6 +2,7 @@
 //! runtime that renders it and shows it, and one frame of the UI. Panels
 //! and input return [`Command`]s; this file applies them.
 
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -321,7 +322,8 @@ impl GlintApp {
     fn say(&mut self, text: impl Into<String>, is_error: bool) {
         let text = text.into();
         if is_error {
-            eprintln!("glint: {text}");
+            // Lost, not a panic, where standard error is closed.
+            let _ = writeln!(std::io::stderr().lock(), "glint: {text}");
         }
         self.messages.push(Message { text, is_error });
         if self.messages.len() > 50 {
@@ -471,7 +473,7 @@ impl GlintApp {
             .as_mut()
             .and_then(|bench| bench.finish(final_shown, &history, counts, describe))
         {
-            println!("{report}");
+            let _ = writeln!(std::io::stdout().lock(), "{report}");
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
         }
     }

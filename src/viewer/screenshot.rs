@@ -5,6 +5,7 @@
 //! so a failure never leaves an existing file emptied or a new one half
 //! written.
 
+use std::io::Write as _;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
@@ -48,7 +49,8 @@ impl Screenshot {
         };
         if self.frames_since_final == 0 {
             for r in &passes {
-                eprintln!(
+                let _ = writeln!(
+                    std::io::stderr().lock(),
                     "glint: {} pass {}x{}: {:.3} s, {:.2} Mrays/s, octree {}",
                     r.kind.label(),
                     r.width,

@@ -552,3 +552,36 @@ fn a_build_without_the_viewer_says_so() {
         stderr(&o)
     );
 }
+
+/// A closed standard error (`glint render ... 2>&1 | true`) loses the
+/// messages, not the render: exit 0 with the file written. A closed
+/// standard output under `--stats` is an error (exit 1), never a panic.
+#[test]
+fn closed_output_streams_do_not_panic() {
+    use std::process::Stdio;
+    let tmp = common::temp_dir();
+    let png = tmp.path().join("a.png");
+    let scene = common::repo_path("scenes/glass.toml");
+    let run = |stats: bool| {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_glint"));
+        cmd.args(["render", scene.to_str().unwrap(), "-o"])
+            .arg(&png)
+            .args(["--width", "32", "--height", "24"])
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped());
+        if stats {
+            cmd.arg("--stats");
+        }
+        let mut child = cmd.spawn().unwrap();
+        // Both readers gone before glint writes a byte.
+        drop(child.stdout.take());
+        drop(child.stderr.take());
+        child.wait().unwrap()
+    };
+    let status = run(false);
+    assert!(status.success(), "{status:?}");
+    assert!(png.exists());
+    let status = run(true);
+    assert_eq!(status.code(), Some(1), "{status:?}");
+}

@@ -157,7 +157,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     for path in &args.scenes {
         let (mut scene, load_s) = load_scene(path)?;
         let settings = bench_settings(args, &mut scene);
-        eprintln!(
+        say!(
             "bench {} ({} shapes, {}x{}, {} spp, {} repeats)",
             path.display(),
             scene.shapes.len(),
@@ -207,7 +207,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         } else {
             String::new()
         };
-        eprintln!(
+        say!(
             "  counted passes: octree on {counted_s:.2} s{}; about {} left for this scene",
             if args.octree_only {
                 String::new()
@@ -224,14 +224,14 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         for r in 0..args.repeat {
             if r > 0 {
                 let per_repeat = repeats_started.elapsed().as_secs_f64() / r as f64;
-                eprintln!(
+                say!(
                     "  repeat {}/{}: about {} left for this scene",
                     r + 1,
                     args.repeat,
                     duration_text(per_repeat * (args.repeat - r) as f64)
                 );
             } else {
-                eprintln!("  repeat 1/{}", args.repeat);
+                say!("  repeat 1/{}", args.repeat);
             }
             full_on.push(timed(|| pool.install(|| renderer_on.render(false, None))).1);
             if r > 0 {
@@ -303,11 +303,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         });
     }
     match args.format {
-        Format::Json => println!("{}", serde_json::to_string_pretty(&results)?),
+        Format::Json => out!("{}", serde_json::to_string_pretty(&results)?)?,
         Format::Markdown => {
-            print!("{}", markdown(&results));
+            out_str!("{}", markdown(&results))?;
             if results.iter().any(|r| r.published.is_some()) {
-                print!("\n{}", counts_markdown(&results));
+                out_str!("\n{}", counts_markdown(&results))?;
             }
         }
     }
@@ -431,17 +431,17 @@ fn sweep(args: &BenchArgs) -> Result<()> {
     let pool = thread_pool(args.threads)?;
     let mut rows = Vec::new();
     if args.format == Format::Markdown {
-        println!(
+        out!(
             "| scene | cost-driven | max depth | leaf size | max duplication | build (s) | render (s) | predicted render (s) | N_IT | predicted N_IT | N_TS | predicted N_TS | N_ETS | nodes | memory (KiB) |"
-        );
-        println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+        )?;
+        out!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")?;
     }
     let threads = pool.current_num_threads();
     for path in &args.scenes {
         let (mut scene, _) = load_scene(path)?;
         let mut settings = bench_settings(args, &mut scene);
         settings.use_octree = true;
-        eprintln!("sweep {}", path.display());
+        say!("sweep {}", path.display());
         // Unit costs once per scene, on its own octree setting.
         let unit_costs = {
             let octree = pool.install(|| scene.build_octree())?;
@@ -477,7 +477,7 @@ fn sweep(args: &BenchArgs) -> Result<()> {
             } else {
                 String::new()
             };
-            eprintln!(
+            say!(
                 "  {}/{count}: depth {max_depth}, leaf {leaf_size}, duplication {max_duplication}, cost-driven {}{left}",
                 k + 1,
                 if cost_driven { "on" } else { "off" }
@@ -524,17 +524,17 @@ fn sweep(args: &BenchArgs) -> Result<()> {
                 fastest: false,
             };
             if args.format == Format::Markdown {
-                print_sweep_row(&row);
+                print_sweep_row(&row)?;
             }
             rows.push(row);
         }
         mark_suggested_and_fastest(&mut rows[first_row..]);
         if args.format == Format::Markdown {
-            print_suggestion(&rows[first_row..]);
+            print_suggestion(&rows[first_row..])?;
         }
     }
     if args.format == Format::Json {
-        println!("{}", serde_json::to_string_pretty(&rows)?);
+        out!("{}", serde_json::to_string_pretty(&rows)?)?;
     }
     Ok(())
 }
@@ -555,12 +555,12 @@ fn mark_suggested_and_fastest(rows: &mut [SweepRow]) {
 
 /// One line under a scene's sweep: the suggested setting, and how its
 /// measured time compares with the sweep's best.
-fn print_suggestion(rows: &[SweepRow]) {
+fn print_suggestion(rows: &[SweepRow]) -> anyhow::Result<()> {
     let (Some(s), Some(f)) = (
         rows.iter().find(|r| r.suggested),
         rows.iter().find(|r| r.fastest),
     ) else {
-        return;
+        return Ok(());
     };
     let describe = |r: &SweepRow| {
         format!(
@@ -575,7 +575,7 @@ fn print_suggestion(rows: &[SweepRow]) {
             }
         )
     };
-    println!(
+    out!(
         "\nSuggested for {} (least predicted build + render): {}: {:.3} s measured; \
          the sweep's fastest: {}: {:.3} s ({:.2}x).\n",
         s.scene,
@@ -584,14 +584,14 @@ fn print_suggestion(rows: &[SweepRow]) {
         describe(f),
         f.build_s + f.render_s,
         (s.build_s + s.render_s) / (f.build_s + f.render_s).max(1e-12)
-    );
+    )
 }
 
-fn print_sweep_row(r: &SweepRow) {
+fn print_sweep_row(r: &SweepRow) -> anyhow::Result<()> {
     let name = std::path::Path::new(&r.scene)
         .file_name()
         .map_or(r.scene.clone(), |n| n.to_string_lossy().into_owned());
-    println!(
+    out!(
         "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {:.0} |",
         name,
         if r.octree_params.cost_driven {
@@ -612,7 +612,7 @@ fn print_sweep_row(r: &SweepRow) {
         r.leaves_visited_per_ray,
         r.octree_stats.nodes,
         r.octree_stats.memory_bytes as f64 / 1024.0
-    );
+    )
 }
 
 /// The scene's settings with the command line's overrides applied (and its

@@ -1,6 +1,35 @@
 //! The `glint` command: headless rendering and benchmarks (and, with the
 //! `gui` feature, the interactive viewer).
 
+/// `println!` returning the failure to write (standard output closed, as
+/// by `| head`, or full) as an error, where `println!` would panic.
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout().lock(), $($arg)*)
+            .map_err(|e| anyhow::anyhow!("cannot write to standard output: {e}"))
+    }};
+}
+
+/// `print!` as [`out!`] does `println!`.
+macro_rules! out_str {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        write!(std::io::stdout().lock(), $($arg)*)
+            .map_err(|e| anyhow::anyhow!("cannot write to standard output: {e}"))
+    }};
+}
+
+/// `eprintln!` for messages: where standard error is closed or full they
+/// are lost, as they would be unread, instead of panicking after the work
+/// is done.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr().lock(), $($arg)*);
+    }};
+}
+
 mod bench;
 mod common;
 mod info;
@@ -72,9 +101,7 @@ fn main() -> std::process::ExitCode {
         #[cfg(not(feature = "gui"))]
         None => {
             use clap::CommandFactory;
-            eprintln!(
-                "glint was built without the viewer (cargo feature `gui`); use a subcommand.\n"
-            );
+            say!("glint was built without the viewer (cargo feature `gui`); use a subcommand.\n");
             let _ = Cli::command().print_help();
             return std::process::ExitCode::from(2);
         }
@@ -82,7 +109,7 @@ fn main() -> std::process::ExitCode {
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            say!("error: {e:#}");
             std::process::ExitCode::FAILURE
         }
     }

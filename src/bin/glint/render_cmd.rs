@@ -250,7 +250,7 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
             let restored = glint::export::restore(png)
                 .with_context(|| format!("cannot render again what {} records", png.display()))?;
             for note in &restored.notes {
-                eprintln!("note: {note}");
+                say!("note: {note}");
             }
             overlay_depth = restored
                 .overlay_depth
@@ -425,7 +425,7 @@ fn report(
             }
             _ => String::new(),
         };
-        eprintln!(
+        say!(
             "wrote {} ({}x{}{written}) in {:.2} s: load {:.2} s, octree build {:.2} s, render {:.2} s",
             if output.as_os_str() == "-" {
                 "standard output".to_string()
@@ -441,10 +441,10 @@ fn report(
         );
     }
     for note in scene.notes() {
-        eprintln!("note: {note}");
+        say!("note: {note}");
     }
     if octree.stats().leaves_stopped_by_budget > 0 {
-        eprintln!(
+        say!(
             "note: the octree build reached its memory budget of {} MiB (nodes, references and \
              the cells still to split, held at once while building; the finished tree takes {:.1} MiB): \
              {} cells stayed leaves; --octree-memory-budget raises it",
@@ -505,7 +505,7 @@ fn report(
             mean: c.mean,
         }),
     };
-    println!("{}", serde_json::to_string_pretty(&stats)?);
+    out!("{}", serde_json::to_string_pretty(&stats)?)?;
     Ok(())
 }
 
@@ -547,6 +547,6 @@ fn print_ray_tree(job: &Prepared, x: u32, y: u32) -> Result<()> {
             .collect(),
         tree: &tree,
     };
-    println!("{}", serde_json::to_string_pretty(&out)?);
+    out!("{}", serde_json::to_string_pretty(&out)?)?;
     Ok(())
 }

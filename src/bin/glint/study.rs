@@ -124,7 +124,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
         let stem = path
             .file_stem()
             .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
-        eprintln!("study {}", path.display());
+        say!("study {}", path.display());
         let mut base = scene.render_settings();
         (base.width, base.height) = (w, h);
         base.use_octree = true;
@@ -361,6 +361,6 @@ pub fn run(args: &StudyArgs) -> Result<()> {
     let out = args.out.join("study.md");
     let text = md.replacen("\n## ", &format!("\n{head}\n## "), 1);
     std::fs::write(&out, text).with_context(|| format!("cannot write {}", out.display()))?;
-    eprintln!("wrote {}", out.display());
+    say!("wrote {}", out.display());
     Ok(())
 }

@@ -217,7 +217,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         .take();
     match outcome {
         Some(Ok(_)) => {
-            eprintln!("glint: saved window screenshot {}", path.display());
+            say!("glint: saved window screenshot {}", path.display());
             Ok(())
         }
         Some(Err(e)) => Err(anyhow!("the screenshot {} failed: {e}", path.display())),
