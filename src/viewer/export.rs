@@ -22,8 +22,22 @@ pub fn choose_path(source: &SceneSource) -> Option<PathBuf> {
     } else {
         // No dialog (no desktop portal, e.g. under Xvfb): never the working
         // directory, which is often a checkout.
-        Some(export_dir(source).join(&default_name))
+        Some(unused_path(&export_dir(source), &default_name))
     }
+}
+
+/// `dir/name`, or where that exists (two exports within a second share a
+/// timestamp) `NAME-2.png`, `NAME-3.png`, ...: an export never replaces
+/// an earlier one.
+fn unused_path(dir: &Path, name: &str) -> PathBuf {
+    let stem = name.strip_suffix(".png").unwrap_or(name);
+    (1..)
+        .map(|k| match k {
+            1 => dir.join(name),
+            k => dir.join(format!("{stem}-{k}.png")),
+        })
+        .find(|p| !p.exists())
+        .unwrap_or_else(|| dir.join(name))
 }
 
 /// Saves the display buffer with the record of how it was made (see
@@ -174,5 +188,20 @@ mod tests {
         // 2000-02-29 (a leap day) 12:34:56 and 2026-11-23 14:05:09.
         assert_eq!(utc_timestamp(951_827_696), "2000-02-29T12-34-56Z");
         assert_eq!(utc_timestamp(1_795_442_709), "2026-11-23T14-05-09Z");
+    }
+
+    #[test]
+    fn an_export_never_takes_an_earlier_ones_name() {
+        let dir = tempfile::tempdir().unwrap();
+        let name = "sphere-2026-11-25T14-17-38Z.png";
+        assert_eq!(unused_path(dir.path(), name), dir.path().join(name));
+        std::fs::write(dir.path().join(name), b"first").unwrap();
+        let second = unused_path(dir.path(), name);
+        assert_eq!(second, dir.path().join("sphere-2026-11-25T14-17-38Z-2.png"));
+        std::fs::write(&second, b"second").unwrap();
+        assert_eq!(
+            unused_path(dir.path(), name),
+            dir.path().join("sphere-2026-11-25T14-17-38Z-3.png")
+        );
     }
 }
