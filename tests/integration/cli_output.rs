@@ -585,3 +585,51 @@ fn closed_output_streams_do_not_panic() {
     let status = run(true);
     assert_eq!(status.code(), Some(1), "{status:?}");
 }
+
+/// Multi-scene commands check every scene file before timing any (a
+/// missing last one failed after the others were measured, with no
+/// results), and `study` keeps two scenes of one name apart.
+#[test]
+fn multi_scene_commands_check_first_and_keep_same_names_apart() {
+    let tmp = common::temp_dir();
+    let sphere = common::repo_path("scenes/sphere.toml");
+    let missing = tmp.path().join("missing.toml");
+    for command in ["bench", "study"] {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_glint"));
+        cmd.args([command, sphere.to_str().unwrap(), missing.to_str().unwrap()])
+            .args(["--size", "8x6", "--repeat", "1"]);
+        if command == "study" {
+            cmd.arg("--out").arg(tmp.path().join("study"));
+        }
+        let out = cmd.output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{command}: {err}");
+        assert!(err.contains("missing.toml"), "{command}: {err}");
+        assert!(
+            !err.contains(&format!("{command} {}", sphere.display())),
+            "{command} timed first: {err}"
+        );
+    }
+    for folder in ["a", "b"] {
+        std::fs::create_dir(tmp.path().join(folder)).unwrap();
+        std::fs::copy(&sphere, tmp.path().join(folder).join("sphere.toml")).unwrap();
+    }
+    let out_dir = tmp.path().join("two");
+    let out = Command::new(env!("CARGO_BIN_EXE_glint"))
+        .arg("study")
+        .args([
+            tmp.path().join("a/sphere.toml"),
+            tmp.path().join("b/sphere.toml"),
+        ])
+        .args(["--size", "8x6", "--repeat", "1", "--out"])
+        .arg(&out_dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(out_dir.join("sphere-aa-need.png").exists());
+    assert!(out_dir.join("sphere-2-aa-need.png").exists());
+}

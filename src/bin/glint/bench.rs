@@ -11,8 +11,8 @@ use glint::stats::RenderCounts;
 use serde::Serialize;
 
 use crate::common::{
-    OctreeArgs, RulesArgs, load_scene, median, parse_positive, parse_samples, parse_size,
-    thread_pool,
+    OctreeArgs, RulesArgs, check_scene_files, load_scene, median, parse_positive, parse_samples,
+    parse_size, thread_pool,
 };
 
 #[derive(clap::Args)]
@@ -148,6 +148,7 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
 
 pub fn run(args: &BenchArgs) -> Result<()> {
     args.rules.check(args.max_depth, args.samples)?;
+    check_scene_files(&args.scenes)?;
     if args.sweep {
         return sweep(args);
     }

@@ -39,6 +39,22 @@ pub fn load_scene(path: &Path) -> Result<(Scene, f64)> {
     Ok((scene, start.elapsed().as_secs_f64()))
 }
 
+/// Checks, before any scene is timed, that every scene file of a
+/// multi-scene command can be opened, so a mistyped last name fails at
+/// once rather than after the others were measured (and with no results).
+pub fn check_scene_files(paths: &[std::path::PathBuf]) -> Result<()> {
+    for path in paths {
+        let kind = std::fs::metadata(path)
+            .with_context(|| format!("cannot read scene file {}", path.display()))?;
+        anyhow::ensure!(
+            kind.is_file(),
+            "cannot read scene file {}: not a regular file",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
 /// Most render threads per core: more only add switching (5,000 threads
 /// made a 0.12 s render take 19.5 s).
 pub const MAX_THREADS_PER_CORE: usize = 8;

@@ -18,7 +18,9 @@ use glint::render::Renderer;
 use glint::scene::Scene;
 use glint::settings::RenderSettings;
 
-use crate::common::{load_scene, median, parse_positive, parse_size, thread_pool};
+use crate::common::{
+    check_scene_files, load_scene, median, parse_positive, parse_size, thread_pool,
+};
 
 #[derive(clap::Args)]
 pub struct StudyArgs {
@@ -95,6 +97,7 @@ fn upsample(f: &Frame, width: u32, height: u32) -> Vec<DVec3> {
 /// Writes `|a - b|` (sRGB-encoded difference, scaled by `gain`) as a PNG.
 pub fn run(args: &StudyArgs) -> Result<()> {
     let (w, h) = args.size;
+    check_scene_files(&args.scenes)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let mut md = String::new();
@@ -119,11 +122,22 @@ pub fn run(args: &StudyArgs) -> Result<()> {
         thread_pool(args.threads)?.current_num_threads()
     )?;
     let mut summary = Vec::new();
+    let mut stems = std::collections::BTreeSet::new();
     for path in &args.scenes {
         let (scene, _) = load_scene(path)?;
-        let stem = path
+        // Two scenes of one name (a/sphere.toml, b/sphere.toml) get their
+        // own pictures and rows: sphere, sphere-2.
+        let file_stem = path
             .file_stem()
             .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+        let stem = (1..)
+            .map(|k| match k {
+                1 => file_stem.clone(),
+                k => format!("{file_stem}-{k}"),
+            })
+            .find(|s| !stems.contains(s))
+            .unwrap_or_default();
+        stems.insert(stem.clone());
         say!("study {}", path.display());
         let mut base = scene.render_settings();
         (base.width, base.height) = (w, h);
