@@ -633,3 +633,35 @@ fn multi_scene_commands_check_first_and_keep_same_names_apart() {
     assert!(out_dir.join("sphere-aa-need.png").exists());
     assert!(out_dir.join("sphere-2-aa-need.png").exists());
 }
+
+/// Flags that would have no effect are refused with the flag they need,
+/// and a GLINT_SIMD that is not taken is said.
+#[test]
+fn flags_without_effect_are_refused_and_a_bad_simd_level_is_said() {
+    let sphere = scene();
+    let out = glint(&["bench", &sphere, "--sweep-depths", "2,4", "--size", "8x8"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--sweep"));
+    let tmp = common::temp_dir();
+    let png = tmp.path().join("a.png");
+    let out = Command::new(env!("CARGO_BIN_EXE_glint"))
+        .env("GLINT_SIMD", "avx9")
+        .args([
+            "render",
+            &sphere,
+            "-o",
+            png.to_str().unwrap(),
+            "--width",
+            "8",
+            "--height",
+            "8",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("GLINT_SIMD=avx9 is not a level"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

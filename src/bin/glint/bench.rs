@@ -65,16 +65,22 @@ pub struct BenchArgs {
     #[arg(long)]
     pub sweep: bool,
     /// Maximum depths for `--sweep` (each 0 to 21).
-    #[arg(long, value_delimiter = ',', default_value = "6,8,10,12", value_parser = crate::common::octree_depth)]
+    #[arg(long, value_delimiter = ',', default_value = "6,8,10,12", value_parser = crate::common::octree_depth, requires = "sweep")]
     pub sweep_depths: Vec<u32>,
     /// Leaf sizes for `--sweep` (each at least 1).
-    #[arg(long, value_delimiter = ',', default_value = "2,4,8,16", value_parser = crate::common::parse_positive)]
+    #[arg(long, value_delimiter = ',', default_value = "2,4,8,16", value_parser = crate::common::parse_positive, requires = "sweep")]
     pub sweep_leaf_sizes: Vec<u32>,
     /// Maximum duplication factors for `--sweep` (each 1 to 8; default: the scene's).
-    #[arg(long, value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..=8))]
+    #[arg(long, value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..=8), requires = "sweep")]
     pub sweep_max_duplications: Vec<u32>,
     /// Cost-driven settings for `--sweep`.
-    #[arg(long, value_delimiter = ',', value_enum, default_value = "on,off")]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_enum,
+        default_value = "on,off",
+        requires = "sweep"
+    )]
     pub sweep_cost_driven: Vec<crate::common::Switch>,
 }
 

@@ -84,6 +84,14 @@ fn main() -> std::process::ExitCode {
         std::process::exit(130);
     });
     let cli = Cli::parse();
+    // A GLINT_SIMD that is not taken (a typo, a level this CPU lacks) is
+    // said, not ignored.
+    let simd = glint::simd::SimdChoice::current();
+    if std::env::var_os("GLINT_SIMD").is_some_and(|v| !v.is_empty())
+        && !simd.reason.starts_with("forced")
+    {
+        say!("note: {}", simd.reason);
+    }
     let result = match cli.command {
         Some(Command::Render(args)) => render_cmd::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),

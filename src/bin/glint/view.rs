@@ -19,7 +19,7 @@ pub struct ViewArgs {
     #[arg(long)]
     pub screenshot: Option<PathBuf>,
     /// Frames to wait after the final pass before the screenshot.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, requires = "screenshot")]
     pub frames: u32,
     /// Initial view mode.
     #[arg(long, value_parser = |s: &str| s.parse::<ViewMode>())]
