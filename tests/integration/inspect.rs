@@ -360,6 +360,22 @@ fn exports_record_how_they_were_made_and_render_again_identically() {
     ] {
         assert!(info.contains(line), "missing {line:?} in\n{info}");
     }
+    // Lights and materials as the file has them are no edits, and an
+    // adaptive render says so.
+    record.settings.edits = Some(glint::export::SceneEdits {
+        lights: scene.lights.clone(),
+        materials: scene.materials.clone(),
+    });
+    record.settings.render.adaptive = true;
+    glint::export::save_rgb_png(&edited, 1, 1, &[9, 9, 9], Some(&record)).unwrap();
+    let out = glint().arg("info").arg(&edited).output().unwrap();
+    let info = String::from_utf8_lossy(&out.stdout);
+    for line in [
+        "edits         none (the scene file's lights and materials)",
+        "samples       16 (adaptive",
+    ] {
+        assert!(info.contains(line), "missing {line:?} in\n{info}");
+    }
     // --legend off: the cost view (and the overlay) at exactly the render's
     // size, recorded, so --from-png makes the same file again.
     for overlay in [&[][..], &["--overlay", "octree"][..]] {

@@ -55,6 +55,21 @@ pub fn check_scene_files(paths: &[std::path::PathBuf]) -> Result<()> {
     Ok(())
 }
 
+/// `word` as a POSIX shell reads it back: as it is when it holds only
+/// characters no shell treats specially, else in single quotes (a quote
+/// inside written `'\''`), so a printed command can be pasted.
+pub fn shell_quoted(word: &str) -> String {
+    let plain = !word.is_empty()
+        && word
+            .bytes()
+            .all(|b| b.is_ascii_alphanumeric() || b"_./-+,:=@%".contains(&b));
+    if plain {
+        word.to_owned()
+    } else {
+        format!("'{}'", word.replace('\'', "'\\''"))
+    }
+}
+
 /// Most render threads per core: more only add switching (5,000 threads
 /// made a 0.12 s render take 19.5 s).
 pub const MAX_THREADS_PER_CORE: usize = 8;
@@ -225,5 +240,18 @@ impl OctreeArgs {
             max_duplication: self.octree_max_duplication,
             memory_budget_mib: self.octree_memory_budget,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::shell_quoted;
+
+    #[test]
+    fn printed_paths_paste_back_into_a_shell() {
+        assert_eq!(shell_quoted("out/a-1.png"), "out/a-1.png");
+        assert_eq!(shell_quoted("sp ace é/out ü.png"), "'sp ace é/out ü.png'");
+        assert_eq!(shell_quoted("it's.png"), "'it'\\''s.png'");
+        assert_eq!(shell_quoted(""), "''");
     }
 }

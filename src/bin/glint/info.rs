@@ -99,7 +99,16 @@ fn write_info(
     if r.corner_rays() {
         writeln!(out, "samples       pixel corners (SPD protocol)")?;
     } else {
-        writeln!(out, "samples       {}", r.samples)?;
+        writeln!(
+            out,
+            "samples       {}{}",
+            r.samples,
+            if r.adaptive {
+                " (adaptive: the grid only where the 1-sample picture needs it)"
+            } else {
+                ""
+            }
+        )?;
     }
     writeln!(out, "max depth     {}", r.max_depth)?;
     writeln!(out, "view          {}", r.view.name())?;
@@ -129,7 +138,22 @@ fn write_info(
     writeln!(out, "camera lookat {}", v3(s.camera.lookat))?;
     writeln!(out, "camera up     {}", v3(s.camera.up))?;
     writeln!(out, "camera fov    {}", s.camera.fov)?;
-    if let Some(e) = &s.edits {
+    // The viewer records the lights and materials it rendered; they are
+    // edits only where they differ from the recorded scene file's.
+    let unedited = s.edits.as_ref().is_some_and(|e| {
+        glint::scene::load_str(
+            &record.scene_text,
+            std::path::Path::new(&record.scene_path),
+            &glint::scene::FileSystem,
+        )
+        .is_ok_and(|file| file.lights == e.lights && file.materials == e.materials)
+    });
+    if unedited {
+        writeln!(
+            out,
+            "edits         none (the scene file's lights and materials)"
+        )?;
+    } else if let Some(e) = &s.edits {
         let c = |c: glint::math::DVec3| format!("{} {} {}", c.x, c.y, c.z);
         writeln!(
             out,
@@ -175,7 +199,7 @@ fn write_info(
     writeln!(
         out,
         "re-render     glint render --from-png {} -o NEW.png",
-        png.display()
+        crate::common::shell_quoted(&png.display().to_string())
     )?;
     if args.scene_text {
         writeln!(out, "---")?;

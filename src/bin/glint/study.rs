@@ -19,7 +19,7 @@ use glint::scene::Scene;
 use glint::settings::RenderSettings;
 
 use crate::common::{
-    check_scene_files, load_scene, median, parse_positive, parse_size, thread_pool,
+    check_scene_files, load_scene, median, parse_positive, parse_size, shell_quoted, thread_pool,
 };
 
 #[derive(clap::Args)]
@@ -108,10 +108,10 @@ pub fn run(args: &StudyArgs) -> Result<()> {
          ({} threads); errors are against a reference render of the same scene.\n",
         args.scenes
             .iter()
-            .map(|p| p.display().to_string())
+            .map(|p| shell_quoted(&p.display().to_string()))
             .collect::<Vec<_>>()
             .join(" "),
-        args.out.display(),
+        shell_quoted(&args.out.display().to_string()),
         format_args!("{w}x{h}"),
         args.repeat,
         if args.repeat == 1 {
