@@ -48,6 +48,11 @@ pub fn parse_obj(
     placement: &Placement,
 ) -> Result<LoadedMesh, String> {
     let data = obj::parse(bytes).map_err(|e| e.to_string())?;
+    // Nothing of OBJ's at all (binary or another format): said as such,
+    // without quoting the content (a mesh path may name any file).
+    if data.positions.is_empty() && data.faces.is_empty() && !data.skipped.statements.is_empty() {
+        return Err("not an OBJ file: it has no vertex or face statement".into());
+    }
     let rotation = placement.rotation();
     let place = |p: DVec3| rotation * (p * placement.scale) + placement.translate;
     let positions: Vec<DVec3> = data.positions.iter().map(|&p| place(p)).collect();

@@ -58,7 +58,8 @@ fn extension(path: &Path) -> Option<String> {
 pub fn load_str(text: &str, path: &Path, files: &dyn FileSource) -> Result<Scene, SceneError> {
     let mut scene = match extension(path).as_deref() {
         Some("toml") => toml_format::parse(text, path, files),
-        Some("nff") => nff::parse(text, path),
+        // A byte-order mark (Windows editors) is not the first entity.
+        Some("nff") => nff::parse(text.strip_prefix('\u{feff}').unwrap_or(text), path),
         Some("obj") => obj_scene::reload(text, path, files),
         _ => Err(SceneError::UnknownFormat {
             path: path.to_owned(),

@@ -541,3 +541,37 @@ fn mtl_dissolve_tr_and_ns_mean_what_exporters_mean() {
         negative.load_notes
     );
 }
+
+/// An NFF with a byte-order mark loads as without it; a file with nothing
+/// of OBJ's (binary, another format) opened as `.obj` is named as not an
+/// OBJ file, without quoting its content.
+#[test]
+fn an_nff_with_a_byte_order_mark_and_an_obj_that_is_none() {
+    let dir = temp_dir();
+    let nff = "b 0.1 0.2 0.3\nv\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0.1\n\
+               resolution 8 8\nl 1 1 1\nf 1 0 0 1 0 1 0 1\ns 0 0 0 1\n";
+    write(dir.path(), "plain.nff", nff.as_bytes());
+    write(
+        dir.path(),
+        "bom.nff",
+        &[&[0xEF, 0xBB, 0xBF][..], nff.as_bytes()].concat(),
+    );
+    let (plain, bom) = (
+        load_file(&dir.path().join("plain.nff")),
+        load_file(&dir.path().join("bom.nff")),
+    );
+    assert_eq!(
+        (bom.shapes, bom.materials, bom.image),
+        (plain.shapes, plain.materials, plain.image)
+    );
+    write(
+        dir.path(),
+        "junk.obj",
+        b"\x7fELF\x02\x01\x01\0\0\0secret: hunter2\n\x01\x02 x y\n",
+    );
+    let message = glint::scene::load(&dir.path().join("junk.obj"))
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains("junk.obj: not an OBJ file"), "{message}");
+    assert!(!message.contains("hunter2"), "{message}");
+}
