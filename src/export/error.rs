@@ -15,6 +15,8 @@ pub enum ExportError {
         "{path}: glint writes PNG images; name the output .png (or give - for standard output)"
     )]
     NotPng { path: PathBuf },
+    #[error("{path} leads to {target}, which is not a .png file: glint does not write over it")]
+    LinkNotPng { path: PathBuf, target: PathBuf },
     #[error("{path} is the scene being rendered; choose another output file")]
     IsInput { path: PathBuf },
     #[error("cannot encode {path} as PNG: {message}")]

@@ -287,6 +287,12 @@ mod tests {
             check_output(&link, Some(&png_scene)),
             Err(ExportError::IsInput { .. })
         ));
+        // A .png link to a file of another kind is named by where it leads.
+        let toml_link = dir.path().join("toml-link.png");
+        std::os::unix::fs::symlink(&scene, &toml_link).unwrap();
+        let e = check_output(&toml_link, None).unwrap_err();
+        assert!(matches!(e, ExportError::LinkNotPng { .. }), "{e}");
+        assert!(e.to_string().contains("leads to"), "{e}");
         assert_eq!(
             check_output(Path::new("-"), None).unwrap(),
             OutputTarget::Stdout

@@ -75,8 +75,16 @@ pub fn check_output(path: &Path, input: Option<&Path>) -> Result<OutputTarget, E
             .and_then(|e| e.to_str())
             .is_some_and(|e| e.eq_ignore_ascii_case("png"));
         if !is_png {
-            return Err(ExportError::NotPng {
-                path: path.to_owned(),
+            // Through a link, the name is not what decides: say where it leads.
+            return Err(if file.file_name() == path.file_name() {
+                ExportError::NotPng {
+                    path: path.to_owned(),
+                }
+            } else {
+                ExportError::LinkNotPng {
+                    path: path.to_owned(),
+                    target: file.to_owned(),
+                }
             });
         }
         if let Some(input) = input
@@ -89,9 +97,19 @@ pub fn check_output(path: &Path, input: Option<&Path>) -> Result<OutputTarget, E
         }
         // The folder must exist and take a new file now, not after a render
         // of minutes: try the temporary file the write will use.
-        temporary_in(&folder_of(file)).map_err(|source| ExportError::Write {
+        let folder = folder_of(file);
+        temporary_in(&folder).map_err(|source| ExportError::Write {
             path: path.to_owned(),
-            source,
+            // tempfile reports some refusals (a folder such as /proc that
+            // takes no new files) without the system's word for them.
+            source: if source.raw_os_error().is_none() && folder.is_dir() {
+                std::io::Error::other(format!(
+                    "the folder {} does not take new files ({source})",
+                    folder.display()
+                ))
+            } else {
+                source
+            },
         })?;
     }
     Ok(target)

@@ -246,6 +246,24 @@ impl Context<'_> {
     }
 }
 
+/// serde's words for the types it expected, in a scene author's: `f64`
+/// is a number, `i64` and the other integers a whole number.
+fn plain_types(message: &str) -> String {
+    let mut out = message.to_owned();
+    for (rust, plain) in [
+        ("expected f64", "expected a number"),
+        ("expected f32", "expected a number"),
+        ("expected i64", "expected a whole number"),
+        ("expected u64", "expected a whole number"),
+        ("expected u32", "expected a whole number"),
+        ("expected i32", "expected a whole number"),
+        ("expected usize", "expected a whole number"),
+    ] {
+        out = out.replace(rust, plain);
+    }
+    out
+}
+
 pub fn parse(text: &str, path: &Path, files: &dyn FileSource) -> Result<Scene, SceneError> {
     let mut cx = Context {
         text,
@@ -256,11 +274,15 @@ pub fn parse(text: &str, path: &Path, files: &dyn FileSource) -> Result<Scene, S
     // (`objects[0].radius`, the style of every other error) from
     // serde_path_to_error and their place from toml's span.
     let de = toml::de::Deserializer::parse(text).map_err(|e| {
-        cx.error(
-            e.span().unwrap_or(0..0),
-            "(syntax)",
-            e.message().trim().to_owned(),
-        )
+        let span = e.span().unwrap_or(0..0);
+        // A key written twice is named: its span is the key.
+        let message = e.message().trim();
+        match text.get(span.clone()).map(str::trim) {
+            Some(k) if message == "duplicate key" && !k.is_empty() => {
+                cx.error(span, k, "written twice in its table")
+            }
+            _ => cx.error(span, "(syntax)", message.to_owned()),
+        }
     })?;
     let file: SceneFile = serde_path_to_error::deserialize(de).map_err(|e| {
         // `Spanned` values add a private segment to the path: drop it.
@@ -280,7 +302,7 @@ pub fn parse(text: &str, path: &Path, files: &dyn FileSource) -> Result<Scene, S
         cx.error(
             inner.span().unwrap_or(0..0),
             &key,
-            inner.message().trim().to_owned(),
+            plain_types(inner.message().trim()),
         )
     })?;
 

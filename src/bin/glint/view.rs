@@ -207,7 +207,31 @@ pub fn run(args: &ViewArgs) -> Result<()> {
             Ok(Box::new(app))
         }),
     )
-    .map_err(|e| anyhow!("the viewer window failed: {e}"))?;
+    .map_err(|e| {
+        // winit's words for a display that does not answer name its own
+        // source file; say what the user can do instead.
+        let text = e.to_string();
+        if text.contains("X server") || text.contains("Wayland") || text.contains("EventLoopError")
+        {
+            let display = ["WAYLAND_DISPLAY", "DISPLAY"]
+                .iter()
+                .find_map(|v| {
+                    std::env::var(v)
+                        .ok()
+                        .filter(|x| !x.is_empty())
+                        .map(|x| format!("{v}={x}"))
+                })
+                .unwrap_or_default();
+            anyhow!(
+                "cannot open a window: no display answers at {display} ({}). Render headless \
+                 with `glint render SCENE -o out.png`, or run the viewer under a virtual \
+                 display: `xvfb-run -a glint view SCENE --screenshot out.png`",
+                text.rsplit(": ").next().unwrap_or(&text).trim()
+            )
+        } else {
+            anyhow!("the viewer window failed: {e}")
+        }
+    })?;
     let Some(path) = &args.screenshot else {
         return Ok(());
     };

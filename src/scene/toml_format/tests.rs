@@ -59,7 +59,12 @@ fn errors_name_file_line_column_and_key() {
         (
             "radius = 1",
             "radius = \"big\"",
-            "test.toml:18:10: `objects[0].radius`: invalid type",
+            "test.toml:18:10: `objects[0].radius`: invalid type: string \"big\", expected a number",
+        ),
+        (
+            "fov = 45",
+            "fov = 45\neye = [0, 0, 4]",
+            "test.toml:7:1: `eye`: written twice in its table",
         ),
         (
             "radius = 1",
