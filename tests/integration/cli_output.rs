@@ -665,3 +665,20 @@ fn flags_without_effect_are_refused_and_a_bad_simd_level_is_said() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// `glint SCENE` is `glint view SCENE` (the default command): without a
+/// display it says the viewer needs one (or, built without the viewer,
+/// that it is not compiled in), never "unrecognized subcommand".
+#[test]
+fn a_scene_as_the_first_argument_opens_the_viewer() {
+    let out = Command::new(env!("CARGO_BIN_EXE_glint"))
+        .env("DISPLAY", "")
+        .env("WAYLAND_DISPLAY", "")
+        .arg(scene())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(!err.contains("unrecognized subcommand"), "{err}");
+    assert!(err.contains("display") || err.contains("without the viewer"), "{err}");
+}

@@ -17,7 +17,7 @@ use crate::common::{
 
 #[derive(clap::Args)]
 pub struct BenchArgs {
-    /// Scene files (.toml or .nff).
+    /// Scene files (.toml, .nff, or an .obj model on its own).
     #[arg(required = true)]
     pub scenes: Vec<PathBuf>,
     /// Image size as WIDTHxHEIGHT (default: each scene's own).

@@ -53,7 +53,7 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Render a scene (TOML or NFF) to a PNG file.
+    /// Render a scene (TOML, NFF, or an OBJ model on its own) to a PNG file.
     Render(render_cmd::RenderArgs),
     /// Time scenes with the octree on and off, interleaved, and report medians.
     Bench(bench::BenchArgs),
@@ -83,7 +83,7 @@ fn main() -> std::process::ExitCode {
         glint::export::remove_unfinished_outputs();
         std::process::exit(130);
     });
-    let cli = Cli::parse();
+    let cli = Cli::parse_from(with_default_command(std::env::args_os().collect()));
     // A GLINT_SIMD that is not taken (a typo, a level this CPU lacks) is
     // said, not ignored.
     let simd = glint::simd::SimdChoice::current();
@@ -143,4 +143,34 @@ mod tests {
             assert!(help.contains(&said), "{name} --help lacks {said:?}");
         }
     }
+}
+
+/// `glint SCENE` is `glint view SCENE`: the viewer is the default command,
+/// so a first argument that names a file (or a scene by its extension)
+/// rather than a subcommand or a flag opens it.
+fn with_default_command(mut args: Vec<std::ffi::OsString>) -> Vec<std::ffi::OsString> {
+    use clap::CommandFactory;
+    let names: Vec<String> = Cli::command()
+        .get_subcommands()
+        .map(|c| c.get_name().to_owned())
+        .chain(["help".to_owned()])
+        .collect();
+    let opens_a_file = args.get(1).is_some_and(|first| {
+        let text = first.to_string_lossy();
+        !text.starts_with('-') && !names.iter().any(|n| *n == text) && {
+            let path = std::path::Path::new(first);
+            // A scene's name that does not exist is the viewer's to
+            // refuse ("cannot read scene file"), not clap's.
+            path.is_file()
+                || path.extension().is_some_and(|e| {
+                    ["toml", "nff", "obj"]
+                        .iter()
+                        .any(|x| e.eq_ignore_ascii_case(x))
+                })
+        }
+    });
+    if opens_a_file {
+        args.insert(1, "view".into());
+    }
+    args
 }

@@ -24,7 +24,7 @@ use crate::common::{
 
 #[derive(clap::Args)]
 pub struct StudyArgs {
-    /// Scene files (.toml or .nff).
+    /// Scene files (.toml, .nff, or an .obj model on its own).
     #[arg(required = true)]
     pub scenes: Vec<PathBuf>,
     /// Output directory for study.md and the images.
