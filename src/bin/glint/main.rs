@@ -123,28 +123,6 @@ fn main() -> std::process::ExitCode {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use clap::CommandFactory;
-
-    #[test]
-    fn the_command_line_definition_is_consistent() {
-        Cli::command().debug_assert();
-    }
-
-    #[test]
-    fn help_states_the_defaults_the_library_uses() {
-        let mut cli = Cli::command();
-        for name in ["render", "bench"] {
-            let command = cli.find_subcommand_mut(name).unwrap();
-            let help = command.render_long_help().to_string();
-            let said = format!("Default {}", glint::accel::DEFAULT_MEMORY_BUDGET_MIB);
-            assert!(help.contains(&said), "{name} --help lacks {said:?}");
-        }
-    }
-}
-
 /// `glint SCENE` is `glint view SCENE`: the viewer is the default command,
 /// so a first argument that names a file (or a scene by its extension)
 /// rather than a subcommand or a flag opens it.
@@ -173,4 +151,26 @@ fn with_default_command(mut args: Vec<std::ffi::OsString>) -> Vec<std::ffi::OsSt
         args.insert(1, "view".into());
     }
     args
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn the_command_line_definition_is_consistent() {
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn help_states_the_defaults_the_library_uses() {
+        let mut cli = Cli::command();
+        for name in ["render", "bench"] {
+            let command = cli.find_subcommand_mut(name).unwrap();
+            let help = command.render_long_help().to_string();
+            let said = format!("Default {}", glint::accel::DEFAULT_MEMORY_BUDGET_MIB);
+            assert!(help.contains(&said), "{name} --help lacks {said:?}");
+        }
+    }
 }
