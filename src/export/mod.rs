@@ -126,6 +126,22 @@ pub fn restore(png: &Path) -> Result<Restored, ExportError> {
             env!("CARGO_PKG_VERSION")
         ));
     }
+    // Meshes and material libraries are not embedded: say which changed
+    // since the export (the picture may then differ).
+    for file in &record.settings.files {
+        let now = scene
+            .files_read
+            .iter()
+            .find(|f| record::absolute_name(&f.path) == file.path);
+        if now.is_none_or(|f| f.sha256 != file.sha256) {
+            notes.push(format!(
+                "{} has changed since {} was made (its SHA-256 differs from the recorded one): \
+                 pixels may differ",
+                file.path,
+                png.display()
+            ));
+        }
+    }
     if record.settings.partial {
         notes.push(format!(
             "{} was exported while a pass was still rendering; this renders the whole pass",

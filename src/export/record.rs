@@ -58,6 +58,18 @@ pub struct RecordedSettings {
     /// in records from before the flag: they all have it.
     #[serde(default = "legend_default", skip_serializing_if = "is_true")]
     pub legend: bool,
+    /// The files besides the scene text it was built from (meshes, MTL
+    /// libraries: not embedded) with their SHA-256, so a re-render can say
+    /// when one has changed. Absent in records from before it.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub files: Vec<RecordedFile>,
+}
+
+/// A file a recorded scene read, as [`RecordedSettings::files`] lists it.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RecordedFile {
+    pub path: String,
+    pub sha256: String,
 }
 
 fn legend_default() -> bool {
@@ -127,6 +139,14 @@ impl RenderRecord {
                 edits: None,
                 partial: false,
                 legend: true,
+                files: scene
+                    .files_read
+                    .iter()
+                    .map(|f| RecordedFile {
+                        path: absolute_name(&f.path),
+                        sha256: f.sha256.clone(),
+                    })
+                    .collect(),
             },
         }
     }
@@ -155,6 +175,15 @@ pub(super) fn validate(s: &RecordedSettings) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// A file's name as a record keeps it: absolute where it exists (a
+/// re-render from another folder resolves it the same), else as given.
+pub fn absolute_name(path: &std::path::Path) -> String {
+    std::fs::canonicalize(path)
+        .unwrap_or_else(|_| path.to_owned())
+        .display()
+        .to_string()
 }
 
 /// SHA-256 of `bytes` as 64 lowercase hex digits (FIPS 180-4, `sha2`).

@@ -24,3 +24,33 @@ impl FileSource for FileSystem {
         std::fs::read(path)
     }
 }
+
+/// A file a scene was built from besides its own text (an OBJ mesh, an
+/// MTL library), with the SHA-256 of the bytes read: what an export
+/// records so that a re-render can tell whether it still has the same.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FileRead {
+    pub path: std::path::PathBuf,
+    pub sha256: String,
+}
+
+/// A [`FileSource`] that remembers what it read.
+pub(super) struct Recording<'a> {
+    pub inner: &'a dyn FileSource,
+    pub read: std::cell::RefCell<Vec<FileRead>>,
+}
+
+impl FileSource for Recording<'_> {
+    fn read(&self, path: &Path) -> std::io::Result<Vec<u8>> {
+        use sha2::Digest;
+        let bytes = self.inner.read(path)?;
+        let mut read = self.read.borrow_mut();
+        if !read.iter().any(|f| f.path == path) {
+            read.push(FileRead {
+                path: path.to_owned(),
+                sha256: format!("{:x}", sha2::Sha256::digest(&bytes)),
+            });
+        }
+        Ok(bytes)
+    }
+}

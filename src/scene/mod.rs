@@ -19,7 +19,7 @@ pub mod toml_format;
 use std::path::Path;
 use std::sync::Arc;
 
-pub use file_source::{FileSource, FileSystem};
+pub use file_source::{FileRead, FileSource, FileSystem};
 pub use model::{ImageSettings, Location, MeshMaterialOrigin, Scene, SceneError};
 pub use obj::SkippedElements;
 pub use polygon::DroppedPolygons;
@@ -56,6 +56,11 @@ fn extension(path: &Path) -> Option<String> {
 /// extension and anchors relative mesh paths. For an `.obj` path the text
 /// is the TOML scene [`load`] wrote around it.
 pub fn load_str(text: &str, path: &Path, files: &dyn FileSource) -> Result<Scene, SceneError> {
+    let recording = file_source::Recording {
+        inner: files,
+        read: Default::default(),
+    };
+    let files = &recording;
     let mut scene = match extension(path).as_deref() {
         Some("toml") => toml_format::parse(text, path, files),
         // A byte-order mark (Windows editors) is not the first entity.
@@ -66,5 +71,6 @@ pub fn load_str(text: &str, path: &Path, files: &dyn FileSource) -> Result<Scene
         }),
     }?;
     scene.source_text = Arc::from(text);
+    scene.files_read = recording.read.into_inner();
     Ok(scene)
 }

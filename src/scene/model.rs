@@ -93,6 +93,9 @@ pub struct Scene {
     /// Which materials a TOML scene's meshes brought from their MTL files:
     /// "Save scene" writes edits to them into the mesh object.
     pub mesh_material_origins: Vec<MeshMaterialOrigin>,
+    /// The files besides its text the scene was built from (meshes, MTL
+    /// libraries), with their SHA-256, in the order read.
+    pub files_read: Vec<super::file_source::FileRead>,
 }
 
 /// A material a mesh object of a TOML scene took from its own file.
@@ -155,6 +158,7 @@ impl Scene {
             color_values: ColorConvention::Linear,
             source_text: Arc::from(""),
             mesh_material_origins: Vec::new(),
+            files_read: Vec::new(),
         }
     }
 

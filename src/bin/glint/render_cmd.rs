@@ -386,7 +386,17 @@ fn save(
     output: &std::path::Path,
 ) -> Result<()> {
     let s = &job.settings;
-    let mut record = glint::export::RenderRecord::new(&job.scene, &job.scene_name, &job.camera, *s);
+    // The record names the scene file by its absolute path, as the
+    // viewer's exports do, so `--from-png` finds it and its meshes from any
+    // folder (the built-in scene keeps its name; --stats keeps the path as
+    // given).
+    let recorded_path = if job.scene_name == glint::scene::builtin::NAME {
+        job.scene_name.clone()
+    } else {
+        std::fs::canonicalize(&job.scene_name)
+            .map_or_else(|_| job.scene_name.clone(), |p| p.display().to_string())
+    };
+    let mut record = glint::export::RenderRecord::new(&job.scene, &recorded_path, &job.camera, *s);
     record.settings.legend = job.legend;
     let camera = glint::camera::Camera::new(&job.camera, s.width, s.height)?;
     let overlay = job
