@@ -305,9 +305,11 @@ fn parse_into(
                 let eye = tokens.vec3("from")?;
                 let from_at = tokens.last();
                 tokens.label("at")?;
+                let lookat_place = tokens.peek_place();
                 let lookat = tokens.vec3("at")?;
                 let at_at = tokens.last();
                 tokens.label("up")?;
+                let up_place = tokens.peek_place();
                 let up = tokens.vec3("up")?;
                 let up_at = tokens.last();
                 tokens.label("angle")?;
@@ -357,7 +359,12 @@ fn parse_into(
                     up,
                     fov: fov_from_nff_angle(angle, h as u32),
                 };
-                if let Err((_, message)) = spec.check() {
+                if let Err((key, message)) = spec.check() {
+                    let (line, column) = match key {
+                        "up" => up_place,
+                        "fov" => angle_place,
+                        _ => lookat_place,
+                    };
                     return Err(tokens.error_at(line, column, "v", message));
                 }
                 camera = Some(spec);
@@ -642,6 +649,11 @@ pp 3
                 "from 0 0 5",
                 "fro 0 0 5",
                 "t.nff:3:1: `v`: expected `from`, got `fro`",
+            ),
+            (
+                "at 0 0 0",
+                "at 0 0 5",
+                "t.nff:4:4: `v`: eye and lookat coincide",
             ),
             (
                 "c 0 0 0 1 0 1 0 0.5",

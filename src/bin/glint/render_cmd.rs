@@ -240,6 +240,12 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
                 "-o - writes the PNG to standard output, where --stats and --trace-pixel \
                  print their JSON: write the image to a file"
             );
+            // Binary PNG bytes would garble the terminal.
+            anyhow::ensure!(
+                !std::io::stdout().is_terminal(),
+                "-o - writes the PNG to standard output, which is a terminal here: \
+                 redirect it (-o - > out.png) or pipe it into a program"
+            );
         }
     }
     let load_start = Instant::now();
