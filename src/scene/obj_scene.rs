@@ -95,8 +95,11 @@ pub(super) fn load(path: &Path, files: &dyn FileSource) -> Result<Scene, SceneEr
 }
 
 /// A camera that frames `bounds` and a light over its shoulder: seen from
-/// the front (+z, the usual forward of OBJ exports), a little from above,
-/// far enough that the bounding sphere fits the view. `None` if that place
+/// the front (+z, the usual forward of OBJ exports) a little from above,
+/// unless the model is far thinner along x or y: then from its broad side
+/// (+x), or from above (a floor or a terrain flat in y), never edge-on (a
+/// model in a plane containing the z axis showed nothing). Far enough
+/// that the bounding sphere fits the view. `None` if that place
 /// is not a finite number (a model reaching 1e300), or so far that the
 /// camera's own length computations overflow (a model 1e154 across).
 fn frame(bounds: Aabb) -> Option<(CameraSpec, DVec3)> {
@@ -119,7 +122,7 @@ fn frame(bounds: Aabb) -> Option<(CameraSpec, DVec3)> {
     // A point model, or one far smaller than its distance from the origin,
     // still needs an eye apart from the lookat point.
     let radius = radius.max(center.abs().max_element() * 1e-9).max(1e-150);
-    let direction = DVec3::new(0.0, 0.25, 1.0).normalize();
+    let direction = view_direction(extent);
     let distance = radius / (0.5 * FOV.to_radians()).sin() * 1.05;
     let camera = CameraSpec {
         eye: center + direction * distance,
@@ -130,6 +133,22 @@ fn frame(bounds: Aabb) -> Option<(CameraSpec, DVec3)> {
     let light = center + DVec3::new(-0.5, 1.0, 0.8).normalize() * (distance * 1.5);
     (camera.eye.is_finite() && light.is_finite() && camera.check().is_ok())
         .then_some((camera, light))
+}
+
+/// Where the camera looks from, seen from the model: +z a little from
+/// above, unless x or y is under half of z's extent (the model's broad
+/// side then faces that axis). OBJ's up is +y, so a model flat in y is
+/// seen steeply from above rather than straight down the up vector.
+fn view_direction(extent: DVec3) -> DVec3 {
+    let thin = |axis: f64| axis < 0.5 * extent.z;
+    let direction = if thin(extent.x) && extent.x <= extent.y {
+        DVec3::new(1.0, 0.25, 0.0)
+    } else if thin(extent.y) {
+        DVec3::new(0.0, 1.0, 0.6)
+    } else {
+        DVec3::new(0.0, 0.25, 1.0)
+    };
+    direction.normalize()
 }
 
 /// Parses `text`, the TOML an OBJ file `path` was opened with (an

@@ -575,3 +575,61 @@ fn an_nff_with_a_byte_order_mark_and_an_obj_that_is_none() {
     assert!(message.contains("junk.obj: not an OBJ file"), "{message}");
     assert!(!message.contains("hunter2"), "{message}");
 }
+
+/// An OBJ opened on its own is framed from its broad side, never edge-on:
+/// a square in the plane x = 0 (which the camera looking along -z saw
+/// edge-on, an empty picture) and a floor flat in y fill the middle of
+/// the picture; a model thin in z keeps the front view. A render in which
+/// no eye ray hits anything says so.
+#[test]
+fn a_model_opened_on_its_own_is_seen_from_its_broad_side() {
+    let dir = temp_dir();
+    for (name, obj) in [
+        (
+            "wall_x.obj",
+            "v 0 -1 -1\nv 0 1 -1\nv 0 1 1\nv 0 -1 1\nf 1 2 3 4\n",
+        ),
+        (
+            "floor_y.obj",
+            "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nf 1 2 3 4\n",
+        ),
+        (
+            "wall_z.obj",
+            "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3 4\n",
+        ),
+    ] {
+        write(dir.path(), name, obj.as_bytes());
+        let scene = load_file(&dir.path().join(name));
+        let image = render(&scene, 32, 32, 1);
+        let background = pixel(&image, 32, 0, 0);
+        assert_ne!(
+            pixel(&image, 32, 16, 16),
+            background,
+            "{name}: the model is in view"
+        );
+        if name == "wall_z.obj" {
+            // The front view, a little from above, as before.
+            let d = (scene.camera.eye - scene.camera.lookat).normalize();
+            assert!((d - glint::math::DVec3::new(0.0, 0.25, 1.0).normalize()).length() < 1e-12);
+        }
+    }
+    let toml = dir.path().join("away.toml");
+    std::fs::write(
+        &toml,
+        facing_scene("wall_z.obj", "").replace("lookat = [0, 0, 0]", "lookat = [0, 0, 9]"),
+    )
+    .unwrap();
+    let png = dir.path().join("away.png");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_glint"))
+        .args([
+            "render",
+            toml.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("no eye ray hit anything"), "{err}");
+}

@@ -459,6 +459,12 @@ fn report(
     for note in scene.notes() {
         say!("note: {note}");
     }
+    if counts.rays.primary > 0 && counts.rays.primary_hits == 0 {
+        say!(
+            "note: no eye ray hit anything: the picture is the background alone (the camera \
+             looks away from the scene, or the scene is far smaller or larger than its view)"
+        );
+    }
     if octree.stats().leaves_stopped_by_budget > 0 {
         say!(
             "note: the octree build reached its memory budget of {} MiB (nodes, references and \
