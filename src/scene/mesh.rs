@@ -2,7 +2,7 @@
 //! MTL materials are `mesh_materials`'s).
 
 use super::obj::{self, NO_NORMAL, SkippedElements};
-use super::polygon::{DroppedPolygons, triangulate};
+use super::polygon::{DroppedPolygons, PolygonDefect, triangulate};
 use crate::math::DVec3;
 
 /// Uniform scale, then rotation about x, y and z (degrees, in that order),
@@ -35,6 +35,10 @@ pub struct LoadedMesh {
     pub libraries: Vec<String>,
     /// Faces that were not simple polygons or had no area.
     pub dropped_polygons: DroppedPolygons,
+    /// The lines of the first few dropped faces, for the note.
+    pub dropped_lines: Vec<u32>,
+    /// Self-crossing (folded) quads split into their two triangles.
+    pub folded_quads: usize,
     /// Elements glint does not render, counted.
     pub skipped: SkippedElements,
 }
@@ -67,6 +71,8 @@ pub fn parse_obj(
     let mut triangle_materials = Vec::new();
     let mut any_normals = false;
     let mut dropped_polygons = DroppedPolygons::default();
+    let mut dropped_lines = Vec::new();
+    let mut folded_quads = 0;
     let mut skipped = data.skipped.clone();
     let mut face: Vec<(u32, u32)> = Vec::new();
     for f in &data.faces {
@@ -91,10 +97,23 @@ pub fn parse_obj(
             vec![[0, 1, 2]]
         } else {
             // Faces are ear-clipped, not fanned: concave faces exist.
-            match triangulate(&corners) {
+            let folded = |defect| match defect {
+                PolygonDefect::NotSimple => folded_quad(&corners),
+                PolygonDefect::ZeroArea => None,
+            };
+            match triangulate(&corners).map_err(|defect| (defect, folded(defect))) {
                 Ok(t) => t,
-                Err(defect) => {
+                // A quad whose outline crosses itself (scanners write
+                // them where the surface folds): its two triangles.
+                Err((_, Some(t))) => {
+                    folded_quads += 1;
+                    t
+                }
+                Err((defect, None)) => {
                     dropped_polygons.record(defect);
+                    if dropped_lines.len() < 5 {
+                        dropped_lines.push(f.line);
+                    }
                     continue;
                 }
             }
@@ -145,8 +164,28 @@ pub fn parse_obj(
         material_names: data.materials,
         libraries: data.libraries,
         dropped_polygons,
+        dropped_lines,
+        folded_quads,
         skipped,
     })
+}
+
+/// A self-crossing quad as two triangles with area: split along the
+/// diagonal whose two halves face the most alike (the fold the scanner
+/// saw), `None` for anything else.
+fn folded_quad(corners: &[DVec3]) -> Option<Vec<[u32; 3]>> {
+    let [a, b, c, d] = corners else {
+        return None;
+    };
+    let normal = |p: DVec3, q: DVec3, r: DVec3| (q - p).cross(r - p).try_normalize();
+    [
+        ([0, 1, 2], [0, 2, 3], normal(*a, *b, *c), normal(*a, *c, *d)),
+        ([0, 1, 3], [1, 2, 3], normal(*a, *b, *d), normal(*b, *c, *d)),
+    ]
+    .into_iter()
+    .filter_map(|(s, t, m, n)| Some((s, t, m?.dot(n?))))
+    .max_by(|x, y| x.2.total_cmp(&y.2))
+    .map(|(s, t, _)| vec![s, t])
 }
 
 /// Area-weighted vertex normals for a triangle soup, vertices matched by
@@ -215,10 +254,21 @@ mod tests {
         assert_eq!(mesh.triangles.len(), 2);
         // Shoelace area of the outline: 4.
         assert!((area - 4.0).abs() < 1e-12, "area {area}");
+        // A folded quad (its outline crosses itself) is split into its two
+        // triangles; a self-crossing five-pointed star is still dropped, its
+        // line kept for the note.
         let bow_tie = "v 0 0 0\nv 1 1 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 4\nf 1 3 2\n";
         let mesh = parse_obj(bow_tie.as_bytes(), None, &identity()).unwrap();
-        assert_eq!(mesh.triangles.len(), 1);
+        assert_eq!(mesh.triangles.len(), 3);
+        assert_eq!(
+            (mesh.folded_quads, mesh.dropped_polygons.not_simple),
+            (1, 0)
+        );
+        let star = "v 0 1 0\nv 0.588 -0.809 0\nv -0.951 0.309 0\nv 0.951 0.309 0\n\
+                    v -0.588 -0.809 0\nf 1 2 3\nf 1 2 3 4 5\n";
+        let mesh = parse_obj(star.as_bytes(), None, &identity()).unwrap();
         assert_eq!(mesh.dropped_polygons.not_simple, 1);
+        assert_eq!(mesh.dropped_lines, [7]);
     }
 
     #[test]

@@ -23,6 +23,8 @@ pub(super) struct Face {
     pub len: u32,
     /// Index into [`ObjData::materials`].
     pub material: u32,
+    /// The line the face is written on, for notes.
+    pub line: u32,
 }
 
 /// What the statements of an OBJ file describe.
@@ -189,6 +191,7 @@ pub(super) fn parse(bytes: &[u8]) -> Result<ObjData, ObjError> {
                     start: start as u32,
                     len: len as u32,
                     material: current_material,
+                    line: number.min(u32::MAX as usize) as u32,
                 });
                 last_line_of_face.push(number);
             }

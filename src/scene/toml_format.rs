@@ -657,6 +657,28 @@ fn add_object(
             .map_err(mesh_error)?;
             scene.dropped_polygons.zero_area += mesh.dropped_polygons.zero_area;
             scene.dropped_polygons.not_simple += mesh.dropped_polygons.not_simple;
+            if !mesh.dropped_lines.is_empty() {
+                let lines: Vec<String> = mesh.dropped_lines.iter().map(u32::to_string).collect();
+                let total = mesh.dropped_polygons.total();
+                scene.load_notes.push(format!(
+                    "{}: faces dropped at line{} {}{}",
+                    mesh_path.display(),
+                    if total == 1 { "" } else { "s" },
+                    lines.join(", "),
+                    if total > lines.len() {
+                        format!(" and {} more", total - lines.len())
+                    } else {
+                        String::new()
+                    }
+                ));
+            }
+            if mesh.folded_quads > 0 {
+                scene.load_notes.push(format!(
+                    "{}: {} folded (self-crossing) quads split into their two triangles",
+                    mesh_path.display(),
+                    mesh.folded_quads
+                ));
+            }
             scene.skipped_elements.add(&mesh.skipped);
             if named.is_some() {
                 if let Some(m) = &obj.materials {

@@ -633,3 +633,27 @@ fn a_model_opened_on_its_own_is_seen_from_its_broad_side() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("no eye ray hit anything"), "{err}");
 }
+
+/// A folded (self-crossing) quad is split into its two triangles and
+/// said; a face still dropped is named by its line.
+#[test]
+fn folded_quads_are_split_and_dropped_faces_named_by_line() {
+    let dir = temp_dir();
+    write(
+        dir.path(),
+        "scan.obj",
+        b"v 0 1 0\nv 0.588 -0.809 0\nv -0.951 0.309 0\nv 0.951 0.309 0\nv -0.588 -0.809 0\n\
+          f 1 2 3 4\nf 1 2 3 4 5\n",
+    );
+    let scene = load_file(&dir.path().join("scan.obj"));
+    assert_eq!(scene.shapes.len(), 2, "the folded quad's two triangles");
+    let notes = scene.notes().join("\n");
+    assert!(
+        notes.contains("1 folded (self-crossing) quads split"),
+        "{notes}"
+    );
+    assert!(
+        notes.contains("scan.obj: faces dropped at line 7"),
+        "{notes}"
+    );
+}
