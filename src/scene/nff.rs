@@ -399,6 +399,7 @@ fn parse_into(
                 }
             }
             "f" => {
+                let f_line = line;
                 let color = tokens.color_in("colour", &UNIT_RANGE)?;
                 let kd = tokens.number_in("Kd", &UNIT_RANGE)?;
                 let ks = tokens.number_in("Ks", &UNIT_RANGE)?;
@@ -406,6 +407,22 @@ fn parse_into(
                 let transparency = tokens.number_in("T", &UNIT_RANGE)?;
                 let (line, column) = tokens.peek_place();
                 let ior = tokens.number("index of refraction")?;
+                // assimp's extension: a texture name after the numbers.
+                let (extra_line, extra_column) = tokens.peek_place();
+                if extra_line == f_line
+                    && let Some(extra) = tokens.tokens.get(tokens.next)
+                {
+                    return Err(tokens.error_at(
+                        extra_line,
+                        extra_column,
+                        "f",
+                        format!(
+                            "an extra field `{}` after the eight numbers (a texture name, as \
+                             assimp writes one): glint's NFF has no textures; remove it",
+                            extra.text
+                        ),
+                    ));
+                }
                 // Opaque materials often give 0 (the SPD's gears do): it is unused.
                 let ior = if transparency > 0.0 {
                     check_range(ior, &IOR_RANGE).map_err(|e| {
@@ -500,6 +517,15 @@ fn parse_into(
                 let normals: Vec<DVec3> = normals.iter().map(|v| v.normalize_or_zero()).collect();
                 // Concave outlines are common (gear faces): ear clipping, not a fan.
                 scene.push_polygon(&vertices, with_normals.then_some(&normals[..]), m);
+            }
+            "nff" if line == 1 => {
+                return Err(tokens.error_at(
+                    line,
+                    column,
+                    "nff",
+                    "this is Sense8's WorldToolKit NFF (it starts with `nff` and a version), \
+                     another format than the Standard Procedural Databases' NFF glint reads",
+                ));
             }
             other => {
                 return Err(tokens.error_at(
@@ -654,6 +680,16 @@ pp 3
                 "at 0 0 0",
                 "at 0 0 5",
                 "t.nff:4:4: `v`: eye and lookat coincide",
+            ),
+            (
+                "0.3 20 0 1\n",
+                "0.3 20 0 1 wood.tga\n",
+                "t.nff:12:28: `f`: an extra field `wood.tga` after the eight numbers",
+            ),
+            (
+                "# a comment\nv\n",
+                "nff\nversion 2.0\nv\n",
+                "t.nff:1:1: `nff`: this is Sense8's WorldToolKit NFF",
             ),
             (
                 "c 0 0 0 1 0 1 0 0.5",
