@@ -85,12 +85,14 @@ pub fn parse_obj(
                 face.push(corner);
             }
         }
-        if face.len() < listed.len() {
-            skipped.faces_with_repeated_vertices += 1;
-        }
+        // Counted once: as short if too few corners are left, else as a
+        // face whose repeats were removed.
         if face.len() < 3 {
             skipped.short_faces += 1;
             continue;
+        }
+        if face.len() < listed.len() {
+            skipped.faces_with_repeated_vertices += 1;
         }
         let corners: Vec<DVec3> = face.iter().map(|&(p, _)| positions[p as usize]).collect();
         let pieces = if face.len() == 3 {

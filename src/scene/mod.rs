@@ -20,7 +20,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 pub use file_source::{FileRead, FileSource, FileSystem};
-pub use model::{ImageSettings, Location, MeshMaterialOrigin, Scene, SceneError};
+pub use model::{ImageSettings, Location, MeshCounts, MeshMaterialOrigin, Scene, SceneError};
 pub use obj::SkippedElements;
 pub use polygon::DroppedPolygons;
 

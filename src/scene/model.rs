@@ -96,6 +96,19 @@ pub struct Scene {
     /// The files besides its text the scene was built from (meshes, MTL
     /// libraries), with their SHA-256, in the order read.
     pub files_read: Vec<super::file_source::FileRead>,
+    /// What each mesh file gave, in the order loaded.
+    pub meshes: Vec<MeshCounts>,
+}
+
+/// What one mesh file gave: triangles loaded, and what was not.
+#[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct MeshCounts {
+    pub path: String,
+    pub triangles: usize,
+    /// Self-crossing quads split into their two triangles.
+    pub folded_quads: usize,
+    pub dropped_polygons: DroppedPolygons,
+    pub skipped_elements: SkippedElements,
 }
 
 /// A material a mesh object of a TOML scene took from its own file.
@@ -159,6 +172,7 @@ impl Scene {
             source_text: Arc::from(""),
             mesh_material_origins: Vec::new(),
             files_read: Vec::new(),
+            meshes: Vec::new(),
         }
     }
 

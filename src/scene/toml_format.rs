@@ -672,6 +672,13 @@ fn add_object(
                     }
                 ));
             }
+            scene.meshes.push(super::model::MeshCounts {
+                path: mesh_path.display().to_string(),
+                triangles: mesh.triangles.len(),
+                folded_quads: mesh.folded_quads,
+                dropped_polygons: mesh.dropped_polygons,
+                skipped_elements: mesh.skipped.clone(),
+            });
             if mesh.folded_quads > 0 {
                 scene.load_notes.push(format!(
                     "{}: {} folded (self-crossing) quads split into their two triangles",

@@ -277,7 +277,8 @@ fn lines_points_and_short_faces_add_nothing_and_are_counted() {
     assert_eq!(scene.shapes.len(), 1);
     let s = &scene.skipped_elements;
     assert_eq!((s.lines, s.points, s.short_faces), (2, 1, 2));
-    assert_eq!(s.faces_with_repeated_vertices, 1);
+    // `f 1 1 2` is one short face, not also a face with a repeat.
+    assert_eq!(s.faces_with_repeated_vertices, 0);
     write(dir.path(), "only_lines.obj", b"v 0 0 0\nv 1 0 0\nl 1 2\n");
     let e = glint::scene::load(&dir.path().join("only_lines.obj")).unwrap_err();
     assert!(e.to_string().contains("no faces"), "{e}");
@@ -656,4 +657,45 @@ fn folded_quads_are_split_and_dropped_faces_named_by_line() {
         notes.contains("scan.obj: faces dropped at line 7"),
         "{notes}"
     );
+}
+
+/// `--stats` counts the shapes by kind and, for each mesh file, the
+/// triangles read beside what was split, dropped or skipped (a face is
+/// counted once: `f 1 1 2` as short, not also as repeated).
+#[test]
+fn stats_count_shapes_by_kind_and_each_mesh() {
+    let dir = temp_dir();
+    write(
+        dir.path(),
+        "m.obj",
+        b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf 1 1 2\nl 1 2\nf 1 2 2 3\n",
+    );
+    let toml = dir.path().join("s.toml");
+    std::fs::write(
+        &toml,
+        facing_scene("m.obj", "")
+            + "[[objects]]\nkind = \"sphere\"\nmaterial = \"grey\"\ncenter = [0, 0, -5]\n\
+               radius = 1\n[materials.grey]\ncolor = [0.5, 0.5, 0.5]\n",
+    )
+    .unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_glint"))
+        .args(["render", toml.to_str().unwrap(), "-o"])
+        .arg(dir.path().join("s.png"))
+        .args(["--width", "8", "--height", "8", "--stats"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stats: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(stats["shapes"]["triangle"], 3);
+    assert_eq!(stats["shapes"]["sphere"], 1);
+    let mesh = &stats["meshes"][0];
+    assert!(mesh["path"].as_str().unwrap().ends_with("m.obj"));
+    assert_eq!(mesh["triangles"], 3);
+    assert_eq!(mesh["skipped_elements"]["short_faces"], 1);
+    assert_eq!(mesh["skipped_elements"]["faces_with_repeated_vertices"], 1);
+    assert_eq!(mesh["skipped_elements"]["lines"], 1);
 }

@@ -162,6 +162,12 @@ struct RenderStats {
     leaves_visited_per_ray: f64,
     nonfinite_samples: u64,
     dropped_degenerate_triangles: usize,
+    /// The shapes rendered, by kind (`triangle`, `sphere`, `plane`,
+    /// `quadric`, `cone`; kinds the scene lacks are left out).
+    shapes: std::collections::BTreeMap<&'static str, usize>,
+    /// Each mesh file: its path, triangles read, folded quads split, and
+    /// what it dropped or skipped.
+    meshes: Vec<glint::scene::MeshCounts>,
     /// Polygons dropped at load: of zero area, or not simple.
     dropped_polygons: glint::scene::DroppedPolygons,
     /// OBJ elements not rendered (lines, points, short faces, other
@@ -516,6 +522,14 @@ fn report(
         leaves_visited_per_ray: per_ray(counts.work.leaves_visited),
         nonfinite_samples: counts.nonfinite_samples,
         dropped_degenerate_triangles: scene.dropped_triangles,
+        shapes: scene
+            .shapes
+            .iter()
+            .fold(Default::default(), |mut by_kind, s| {
+                *by_kind.entry(s.kind().name()).or_default() += 1;
+                by_kind
+            }),
+        meshes: scene.meshes.clone(),
         dropped_polygons: scene.dropped_polygons,
         skipped_elements: scene.skipped_elements.clone(),
         not_rendered: scene.not_rendered.clone(),
