@@ -29,6 +29,9 @@ pub(super) struct ShadingPoint {
     /// Whether the ray meets the surface from outside.
     entering: bool,
     material: u32,
+    /// The diffuse colour here: the material's, or the vertex colours
+    /// interpolated across a triangle that has them.
+    color: Color,
 }
 
 impl Renderer<'_> {
@@ -108,6 +111,17 @@ impl Renderer<'_> {
         };
         let smooth = self.settings.protocol == Protocol::Glint
             && matches!(shape, Shape::Triangle(t) if t.has_vertex_normals());
+        let color = match scene.shape_colors.get(hit.shape as usize) {
+            Some(&i) if i != u32::MAX => {
+                let [c0, c1, c2] = scene.vertex_colors[i as usize];
+                let (b1, b2) = (hit.hit.b1, hit.hit.b2);
+                let c = (1.0 - b1 - b2) * c0 + b1 * c1 + b2 * c2;
+                self.settings
+                    .colors
+                    .shading_color(scene.color_values, c.clamp(Color::ZERO, Color::ONE))
+            }
+            _ => self.materials[material as usize].color,
+        };
         rec.material(material);
         rec.hit(|| HitRecord {
             object: hit.shape,
@@ -126,6 +140,7 @@ impl Renderer<'_> {
             normal,
             entering,
             material,
+            color,
         }
     }
 
@@ -168,7 +183,7 @@ impl Renderer<'_> {
     #[inline(always)]
     pub(super) fn ambient(&self, at: &ShadingPoint) -> Color {
         let material = &self.materials[at.material as usize];
-        material.ka * self.scene.image.ambient * material.color
+        material.ka * self.scene.image.ambient * at.color
     }
 
     /// Where shadow rays from `at` start: off the surface on the side the
@@ -256,7 +271,7 @@ impl Renderer<'_> {
         let material = &self.materials[at.material as usize];
         let n = at.normal;
         let light = &self.scene.lights[index];
-        let diffuse = material.kd * n_dot_l * material.color;
+        let diffuse = material.kd * n_dot_l * at.color;
         // Without a highlight the Phong term is exactly 0 (its power is
         // at most 1): skip the power, the costliest step of shading.
         let specular = if material.ks == 0.0 {

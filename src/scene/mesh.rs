@@ -39,6 +39,10 @@ pub struct LoadedMesh {
     pub dropped_lines: Vec<u32>,
     /// Self-crossing (folded) quads split into their two triangles.
     pub folded_quads: usize,
+    /// Per-triangle vertex colours (`v x y z r g b`), in [0, 1]: empty
+    /// when the file has none, `None` for a triangle with a corner
+    /// written without one.
+    pub colors: Vec<Option<[DVec3; 3]>>,
     /// Elements glint does not render, counted.
     pub skipped: SkippedElements,
 }
@@ -69,6 +73,20 @@ pub fn parse_obj(
     let mut triangles = Vec::new();
     let mut triangle_normals = Vec::new();
     let mut triangle_materials = Vec::new();
+    let mut triangle_colors = Vec::new();
+    // Colours written 0-255 (some scanners) rather than 0-1: scaled.
+    let color_scale = if data.colors.iter().flatten().any(|c| c.max_element() > 1.0) {
+        1.0 / 255.0
+    } else {
+        1.0
+    };
+    let color_of = |p: u32| {
+        data.colors
+            .get(p as usize)
+            .copied()
+            .flatten()
+            .map(|c| (c * color_scale).clamp(DVec3::ZERO, DVec3::ONE))
+    };
     let mut any_normals = false;
     let mut dropped_polygons = DroppedPolygons::default();
     let mut dropped_lines = Vec::new();
@@ -131,6 +149,10 @@ pub fn parse_obj(
                 [DVec3::ZERO; 3]
             });
             triangle_materials.push(f.material);
+            if !data.colors.is_empty() {
+                let [ca, cb, cc] = [a, b, c].map(|k| color_of(face[k].0));
+                triangle_colors.push(ca.zip(cb).zip(cc).map(|((a, b), c)| [a, b, c]));
+            }
         }
     }
     if triangles.is_empty() {
@@ -168,6 +190,7 @@ pub fn parse_obj(
         dropped_polygons,
         dropped_lines,
         folded_quads,
+        colors: triangle_colors,
         skipped,
     })
 }

@@ -71,6 +71,12 @@ pub struct Scene {
     pub shape_materials: Arc<Vec<u32>>,
     /// Per-triangle vertex normals of smooth-shaded triangles, unit length.
     pub vertex_normals: Arc<Vec<[DVec3; 3]>>,
+    /// Per-triangle vertex colours (an OBJ's `v x y z r g b`), in [0, 1].
+    pub vertex_colors: Arc<Vec<[DVec3; 3]>>,
+    /// For each shape, its entry in `vertex_colors` (`u32::MAX`: none;
+    /// shapes past the end have none): the colour replaces the material's
+    /// diffuse colour, interpolated across the face.
+    pub shape_colors: Arc<Vec<u32>>,
     /// Degenerate triangles dropped while loading (they could never be hit).
     pub dropped_triangles: usize,
     /// Polygons dropped while loading: zero area, or not simple.
@@ -163,6 +169,8 @@ impl Scene {
             shapes: Arc::default(),
             shape_materials: Arc::default(),
             vertex_normals: Arc::default(),
+            vertex_colors: Arc::default(),
+            shape_colors: Arc::default(),
             dropped_triangles: 0,
             dropped_polygons: DroppedPolygons::default(),
             skipped_elements: SkippedElements::default(),
@@ -259,10 +267,20 @@ impl Scene {
         &mut self,
         triangles: Vec<[DVec3; 3]>,
         normals: Option<Vec<[DVec3; 3]>>,
+        colors: &[Option<[DVec3; 3]>],
         material: impl Fn(usize) -> u32,
     ) {
         for (i, vertices) in triangles.into_iter().enumerate() {
+            let before = self.shapes.len();
             self.push_triangle(vertices, normals.as_ref().map(|n| n[i]), material(i));
+            if let Some(Some(c)) = colors.get(i)
+                && self.shapes.len() > before
+            {
+                let shape_colors = Arc::make_mut(&mut self.shape_colors);
+                shape_colors.resize(before, u32::MAX);
+                shape_colors.push(self.vertex_colors.len() as u32);
+                Arc::make_mut(&mut self.vertex_colors).push(*c);
+            }
         }
     }
 
@@ -433,7 +451,12 @@ mod tests {
         let lengths = [1e-200, 1e-150, 1e-3, 1.0, 7.5, 1e150, 1e300];
         let mut scene = empty();
         let normals = lengths.map(|s| [DVec3::new(0.0, 0.6, 0.8) * s; 3]);
-        scene.push_mesh(vec![triangle; lengths.len()], Some(normals.to_vec()), |_| 0);
+        scene.push_mesh(
+            vec![triangle; lengths.len()],
+            Some(normals.to_vec()),
+            &[],
+            |_| 0,
+        );
         assert_eq!(scene.vertex_normals.len(), lengths.len());
         for n in scene.vertex_normals.iter().flatten() {
             assert!((n.length() - 1.0).abs() < 1e-15, "{n}");
@@ -445,7 +468,12 @@ mod tests {
             DVec3::splat(f64::NAN),
             DVec3::new(1.0, f64::INFINITY, 0.0),
         ] {
-            scene.push_mesh(vec![triangle], Some(vec![[DVec3::Z, bad, DVec3::Z]]), |_| 0);
+            scene.push_mesh(
+                vec![triangle],
+                Some(vec![[DVec3::Z, bad, DVec3::Z]]),
+                &[],
+                |_| 0,
+            );
         }
         assert!(scene.vertex_normals.is_empty());
         assert_eq!(scene.shapes.len(), 3);

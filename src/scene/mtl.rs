@@ -8,6 +8,7 @@
 //! | `Ns` | `shininess`; below 1 no highlight (`ks = 0`): Blender writes `Ns 0` for a fully rough surface, 3ds Max for glossiness 0; a negative `Ns` gets a note |
 //! | `d` (dissolve) | a blend: the surface terms (`ka`, `kd`, `ks`) scaled by `d`, `transparency = 1 - d` straight through (refracting only for `illum 6, 7`), so `d 0` shows what lies behind |
 //! | `Tr` | `1 - d` where no `d` is written (`d` wins, with a note, when both are and disagree); `Tr 1` alone, which would make the material invisible, is read as opaque (MeshLab and others write it meaning opaque), with a note |
+//! | OBJ vertex colours | the diffuse colour in place of `Kd`, interpolated across the face (`scene::mesh`) |
 //! | `Tf` | `transparency` = mean of `Tf` for refracting models (6, 7) when `d` is 1 |
 //! | `Ni` | `ior` for refracting models (6, 7), brought within 0.01 to 100 with a load note; `illum 4` and `9` are glass without refraction (`ior = 1`) |
 //! | `illum 0, 1` | diffuse only (`ks = 0`); 0 also without ambient (`ka = 0`) |

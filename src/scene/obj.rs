@@ -31,6 +31,9 @@ pub(super) struct Face {
 #[derive(Debug, Default)]
 pub(super) struct ObjData {
     pub positions: Vec<DVec3>,
+    /// Vertex colours (`v x y z r g b`), by position index; empty when
+    /// the file has none, `None` for a vertex written without one.
+    pub colors: Vec<Option<DVec3>>,
     pub normals: Vec<DVec3>,
     /// Every face's corners: (position index, normal index or `NO_NORMAL`),
     /// zero-based and checked against the final vertex counts.
@@ -172,9 +175,24 @@ pub(super) fn parse(bytes: &[u8]) -> Result<ObjData, ObjError> {
                 if !p.is_finite() {
                     return Err(err("coordinates must be finite".into()));
                 }
-                // `v x y z w`: w weighs rational curves and is ignored; a
-                // fourth to sixth number may also be a vertex colour.
+                // `v x y z w`: w weighs rational curves and is ignored;
+                // `v x y z r g b` (MeshLab, scanners) gives a colour.
                 if keyword == b"v" {
+                    let rest: Vec<&[u8]> = args.collect();
+                    if rest.len() >= 3 {
+                        let mut rgb = [0.0; 3];
+                        for (value, token) in rgb.iter_mut().zip(&rest) {
+                            *value = number_of(token).ok_or_else(|| {
+                                err(format!("vertex colour `{}` is not a number", lossy(token)))
+                            })?;
+                        }
+                        let c = DVec3::from_array(rgb);
+                        if !c.is_finite() {
+                            return Err(err("vertex colours must be finite".into()));
+                        }
+                        data.colors.resize(data.positions.len(), None);
+                        data.colors.push(Some(c));
+                    }
                     data.positions.push(p);
                 } else {
                     data.normals.push(p);
@@ -246,6 +264,9 @@ pub(super) fn parse(bytes: &[u8]) -> Result<ObjData, ObjError> {
                 corner.1 = NO_NORMAL;
             }
         }
+    }
+    if !data.colors.is_empty() {
+        data.colors.resize(data.positions.len(), None);
     }
     Ok(data)
 }

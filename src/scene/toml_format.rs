@@ -695,7 +695,7 @@ fn add_object(
                         "`materials` changes a mesh's own materials; with `material` it has none",
                     ));
                 }
-                scene.push_mesh(mesh.triangles, mesh.normals, |_| material);
+                scene.push_mesh(mesh.triangles, mesh.normals, &mesh.colors, |_| material);
             } else {
                 let (slots, default) =
                     super::mesh_materials::mesh_materials(scene, &mesh, &mesh_path, files);
@@ -737,7 +737,7 @@ fn add_object(
                         }
                     }));
                 let per_triangle = &mesh.triangle_materials;
-                scene.push_mesh(mesh.triangles, mesh.normals, |i| {
+                scene.push_mesh(mesh.triangles, mesh.normals, &mesh.colors, |i| {
                     slots[per_triangle[i] as usize]
                 });
             }

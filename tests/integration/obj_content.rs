@@ -699,3 +699,46 @@ fn stats_count_shapes_by_kind_and_each_mesh() {
     assert_eq!(mesh["skipped_elements"]["faces_with_repeated_vertices"], 1);
     assert_eq!(mesh["skipped_elements"]["lines"], 1);
 }
+
+/// Vertex colours (`v x y z r g b`) are the diffuse colour, interpolated
+/// across each face in place of the material's: a quad red at its left
+/// corners and blue at its right shows red on the left, blue on the
+/// right, a mix between; the same colours written 0-255 render the same;
+/// a colour that is not finite is refused with its line.
+#[test]
+fn vertex_colours_are_interpolated_as_the_diffuse_colour() {
+    let dir = temp_dir();
+    let quad = |scale: f64| {
+        format!(
+            "v -1 -1 0 {r} 0 0\nv 1 -1 0 0 0 {r}\nv 1 1 0 0 0 {r}\nv -1 1 0 {r} 0 0\nf 1 2 3 4\n",
+            r = scale
+        )
+    };
+    write(dir.path(), "rgb.obj", quad(1.0).as_bytes());
+    let toml = dir.path().join("rgb.toml");
+    std::fs::write(&toml, facing_scene("rgb.obj", "")).unwrap();
+    let image = render(&load_file(&toml), 40, 40, 1);
+    let (left, middle, right) = (
+        pixel(&image, 40, 8, 20),
+        pixel(&image, 40, 20, 20),
+        pixel(&image, 40, 31, 20),
+    );
+    assert!(left[0] > 100 && left[2] < left[0] / 4, "left {left:?}");
+    assert!(right[2] > 100 && right[0] < right[2] / 4, "right {right:?}");
+    assert!(middle[0] > 20 && middle[2] > 20, "middle {middle:?}");
+    assert_eq!(left[1], 0);
+    write(dir.path(), "rgb.obj", quad(255.0).as_bytes());
+    assert_eq!(render(&load_file(&toml), 40, 40, 1), image, "0-255 colours");
+    write(
+        dir.path(),
+        "bad.obj",
+        b"v 0 0 0\nv 1 0 0 inf 0 0\nv 0 1 0\nf 1 2 3\n",
+    );
+    let message = glint::scene::load(&dir.path().join("bad.obj"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("line 2") && message.contains("vertex colours must be finite"),
+        "{message}"
+    );
+}
