@@ -40,6 +40,15 @@ pub enum ExportError {
     },
     #[error(transparent)]
     Scene(#[from] crate::scene::SceneError),
+    #[error(
+        "the scene was too large to embed in the PNG (over 16 MiB): --from-png needs {path} \
+         with SHA-256 {sha256}, {}", if *found { "and that file has changed" } else { "which cannot be read" }
+    )]
+    SceneNotEmbedded {
+        path: String,
+        sha256: String,
+        found: bool,
+    },
     #[error("the recorded light and material edits do not fit the recorded scene {scene}")]
     EditsMismatch { scene: String },
     #[error(

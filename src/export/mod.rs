@@ -25,8 +25,9 @@ pub use output::{
 };
 pub use png_file::{read_record, read_record_bytes};
 pub use record::{
-    KEY_SCENE, KEY_SCENE_PATH, KEY_SCENE_SHA256, KEY_SETTINGS, KEY_VERSION, MAX_SCENE_TEXT,
-    RecordedCamera, RecordedSettings, RenderRecord, SCENE_CHUNK, SceneEdits, sha256_hex,
+    KEY_SCENE, KEY_SCENE_PATH, KEY_SCENE_SHA256, KEY_SETTINGS, KEY_VERSION, MAX_EMBEDDED_SCENE,
+    MAX_SCENE_TEXT, RecordedCamera, RecordedSettings, RenderRecord, SCENE_CHUNK, SceneEdits,
+    sha256_hex,
 };
 
 use crate::accel::Octree;
@@ -173,6 +174,18 @@ pub fn load_recorded_scene_with(
 ) -> Result<Scene, ExportError> {
     let mut scene = if record.scene_path == crate::scene::builtin::NAME {
         crate::scene::builtin::load_text(&record.scene_text)?
+    } else if record.settings.scene_not_embedded {
+        // Too large to embed: the file itself, as long as it is the same.
+        let path = Path::new(&record.scene_path);
+        let bytes = files.read(path).ok();
+        if bytes.as_deref().map(sha256_hex).as_ref() != Some(&record.scene_sha256) {
+            return Err(ExportError::SceneNotEmbedded {
+                path: record.scene_path.clone(),
+                sha256: record.scene_sha256.clone(),
+                found: bytes.is_some(),
+            });
+        }
+        crate::scene::load_with(path, files)?
     } else {
         crate::scene::load_str(&record.scene_text, Path::new(&record.scene_path), files)?
     };

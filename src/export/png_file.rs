@@ -54,13 +54,15 @@ pub(super) fn write_png(
             chunk.compressed = text.len() > 1024;
             writer.write_text_chunk(&chunk).map_err(encode)?;
         }
-        let scene = compress(r.scene_text.as_bytes()).map_err(|e| ExportError::Encode {
-            path: path.to_owned(),
-            message: e.to_string(),
-        })?;
-        writer
-            .write_chunk(png::chunk::ChunkType(SCENE_CHUNK), &scene)
-            .map_err(encode)?;
+        if !r.settings.scene_not_embedded {
+            let scene = compress(r.scene_text.as_bytes()).map_err(|e| ExportError::Encode {
+                path: path.to_owned(),
+                message: e.to_string(),
+            })?;
+            writer
+                .write_chunk(png::chunk::ChunkType(SCENE_CHUNK), &scene)
+                .map_err(encode)?;
+        }
     }
     writer.write_image_data(rgb).map_err(encode)?;
     writer.finish().map_err(encode)
@@ -136,6 +138,7 @@ fn read_record_from<R: std::io::BufRead + std::io::Seek>(
             key: KEY_SCENE,
             message,
         })?,
+        None if settings.scene_not_embedded => String::new(),
         None => text(KEY_SCENE)?,
     };
     let record = RenderRecord {
@@ -151,7 +154,7 @@ fn read_record_from<R: std::io::BufRead + std::io::Seek>(
         message,
     })?;
     let computed = sha256_hex(record.scene_text.as_bytes());
-    if computed != record.scene_sha256 {
+    if !record.settings.scene_not_embedded && computed != record.scene_sha256 {
         return Err(ExportError::Checksum {
             path: path.to_owned(),
             recorded: record.scene_sha256,

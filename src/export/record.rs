@@ -23,6 +23,12 @@ pub const SCENE_CHUNK: [u8; 4] = *b"glSc";
 /// scene file (the largest SPD size, tetra_s8, is 5 MB), and a bound on
 /// what a crafted PNG can make glint allocate.
 pub const MAX_SCENE_TEXT: usize = 256 << 20;
+/// Largest scene text a record embeds: every bundled scene (tetra_s8,
+/// 5 MB, the largest) and anything a person writes by hand fits; past it
+/// (generated scenes of tens of megabytes, which made an 8x6 render's PNG
+/// 7.6 MB and took seconds to compress) the record keeps the scene's path
+/// and SHA-256 only, and `--from-png` reads the file there, checked.
+pub const MAX_EMBEDDED_SCENE: usize = 16 << 20;
 
 /// How an image was made: enough to make it again.
 #[derive(Clone, Debug, PartialEq)]
@@ -63,6 +69,10 @@ pub struct RecordedSettings {
     /// when one has changed. Absent in records from before it.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub files: Vec<RecordedFile>,
+    /// The scene text was past [`MAX_EMBEDDED_SCENE`] and is not in the
+    /// PNG: the record holds its path and SHA-256 only.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub scene_not_embedded: bool,
 }
 
 /// A file a recorded scene read, as [`RecordedSettings::files`] lists it.
@@ -130,7 +140,12 @@ impl RenderRecord {
             glint_version: env!("CARGO_PKG_VERSION").to_string(),
             scene_path: scene_path.to_string(),
             scene_sha256: sha256_hex(scene.source_text.as_bytes()),
-            scene_text: scene.source_text.to_string(),
+            // Past the limit, the path and hash stand for the text.
+            scene_text: if scene.source_text.len() > MAX_EMBEDDED_SCENE {
+                String::new()
+            } else {
+                scene.source_text.to_string()
+            },
             settings: RecordedSettings {
                 camera: camera.into(),
                 render: settings,
@@ -147,6 +162,7 @@ impl RenderRecord {
                         sha256: f.sha256.clone(),
                     })
                     .collect(),
+                scene_not_embedded: scene.source_text.len() > MAX_EMBEDDED_SCENE,
             },
         }
     }

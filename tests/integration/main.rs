@@ -8,6 +8,7 @@ mod common;
 
 mod adaptive_aa;
 mod cli_output;
+mod cli_records;
 mod extremes;
 mod inspect;
 mod module_graph;

@@ -185,17 +185,24 @@ fn write_info(
             )?;
         }
     }
-    writeln!(
-        out,
-        "scene text    {} bytes, {} lines{}",
-        record.scene_text.len(),
-        record.scene_text.lines().count(),
-        if args.scene_text {
-            ""
-        } else {
-            " (--scene-text prints it)"
-        }
-    )?;
+    if s.scene_not_embedded {
+        writeln!(
+            out,
+            "scene text    not embedded (over 16 MiB): --from-png reads the file at the scene path, checked against its SHA-256"
+        )?;
+    } else {
+        writeln!(
+            out,
+            "scene text    {} bytes, {} lines{}",
+            record.scene_text.len(),
+            record.scene_text.lines().count(),
+            if args.scene_text {
+                ""
+            } else {
+                " (--scene-text prints it)"
+            }
+        )?;
+    }
     writeln!(
         out,
         "re-render     glint render --from-png {} -o NEW.png",

@@ -227,8 +227,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         anyhow::bail!("give an output file with -o");
     };
     let (rendered, render_s) = render(&job, args.stats)?;
+    let write_start = Instant::now();
     save(&job, &rendered.frame, output)?;
-    report(args, &job, &rendered, output, render_s)
+    let write_s = write_start.elapsed().as_secs_f64();
+    report(args, &job, &rendered, output, (render_s, write_s))
 }
 
 /// Checks the output, loads the scene (or the recorded one), applies the
@@ -429,7 +431,7 @@ fn report(
     job: &Prepared,
     rendered: &RenderedFrame,
     output: &std::path::Path,
-    render_s: f64,
+    (render_s, write_s): (f64, f64),
 ) -> Result<()> {
     let (scene, settings, octree) = (&job.scene, &job.settings, &job.octree);
     let (frame, counts) = (&rendered.frame, &rendered.counts);
@@ -448,7 +450,7 @@ fn report(
             _ => String::new(),
         };
         say!(
-            "wrote {} ({}x{}{written}) in {:.2} s: load {:.2} s, octree build {:.2} s, render {:.2} s",
+            "wrote {} ({}x{}{written}) in {:.2} s: load {:.2} s, octree build {:.2} s, render {:.2} s, write {:.2} s",
             if output.as_os_str() == "-" {
                 "standard output".to_string()
             } else {
@@ -456,10 +458,11 @@ fn report(
             },
             width,
             height,
-            job.load_s + job.build_s + render_s,
+            job.load_s + job.build_s + render_s + write_s,
             job.load_s,
             job.build_s,
-            render_s
+            render_s,
+            write_s
         );
     }
     for note in scene.notes() {
