@@ -98,6 +98,28 @@ pub fn parse_obj(
         // lists its four corners 234 times is a quad, not 936 triangles.
         face.clear();
         let listed = &data.corners[f.start as usize..(f.start + f.len) as usize];
+        // A face with a hole written as one bridged polygon: triangulated
+        // as the ring it describes (removing the repeats cut a wedge out).
+        if listed.len() >= 8
+            && let Some(pieces) = keyhole_face(listed, &positions)
+        {
+            let has_normals = listed.iter().all(|&(_, n)| n != NO_NORMAL);
+            any_normals |= has_normals;
+            for t in pieces {
+                triangles.push(t.map(|k| positions[listed[k as usize].0 as usize]));
+                triangle_normals.push(if has_normals {
+                    t.map(|k| normals[listed[k as usize].1 as usize])
+                } else {
+                    [DVec3::ZERO; 3]
+                });
+                triangle_materials.push(f.material);
+                if !data.colors.is_empty() {
+                    let [ca, cb, cc] = t.map(|k| color_of(listed[k as usize].0));
+                    triangle_colors.push(ca.zip(cb).zip(cc).map(|((a, b), c)| [a, b, c]));
+                }
+            }
+            continue;
+        }
         for &corner in listed {
             if !face.iter().any(|&(p, _)| p == corner.0) {
                 face.push(corner);
@@ -193,6 +215,14 @@ pub fn parse_obj(
         colors: triangle_colors,
         skipped,
     })
+}
+
+/// A keyhole face's triangles (indices into `listed`), if it is one: its
+/// corners repeat a vertex, in the `a b … b a` pattern of a bridge.
+fn keyhole_face(listed: &[(u32, u32)], positions: &[DVec3]) -> Option<Vec<[u32; 3]>> {
+    let ids: Vec<u32> = listed.iter().map(|&(p, _)| p).collect();
+    let corners: Vec<DVec3> = ids.iter().map(|&p| positions[p as usize]).collect();
+    super::keyhole::triangulate_keyhole(&ids, &corners)
 }
 
 /// A self-crossing quad as two triangles with area: split along the

@@ -4,6 +4,7 @@
 
 pub mod builtin;
 mod file_source;
+mod keyhole;
 mod mesh;
 mod mesh_materials;
 mod model;

@@ -742,3 +742,47 @@ fn vertex_colours_are_interpolated_as_the_diffuse_colour() {
         "{message}"
     );
 }
+
+/// A face with a hole written as one bridged polygon (LightWave, 3ds Max:
+/// outer loop, bridge, inner loop, bridge back) renders as the ring it
+/// describes, as the same ring written as four faces does; removing the
+/// repeated corners cut a wedge out of it.
+#[test]
+fn a_bridged_polygon_with_a_hole_renders_as_its_ring() {
+    let dir = temp_dir();
+    let vertices = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n\
+                    v -0.5 -0.5 0\nv 0.5 -0.5 0\nv 0.5 0.5 0\nv -0.5 0.5 0\n";
+    write(
+        dir.path(),
+        "keyhole.obj",
+        format!("{vertices}f 1 5 8 7 6 5 1 2 3 4\n").as_bytes(),
+    );
+    write(
+        dir.path(),
+        "quads.obj",
+        format!("{vertices}f 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n").as_bytes(),
+    );
+    let image = |obj: &str| {
+        let toml = dir.path().join(format!("{obj}.toml"));
+        std::fs::write(&toml, facing_scene(obj, "")).unwrap();
+        let scene = load_file(&toml);
+        assert!(scene.load_notes.is_empty(), "{:?}", scene.load_notes);
+        render(&scene, 40, 40, 1)
+    };
+    let (keyhole, quads) = (image("keyhole.obj"), image("quads.obj"));
+    // The hole shows the background; the ring's four sides are there.
+    assert_eq!(
+        pixel(&keyhole, 40, 20, 20),
+        pixel(&keyhole, 40, 0, 0),
+        "the hole"
+    );
+    for (x, y) in [(20, 8), (20, 31), (8, 20), (31, 20)] {
+        assert_ne!(
+            pixel(&keyhole, 40, x, y),
+            pixel(&keyhole, 40, 0, 0),
+            "ring at {x},{y}"
+        );
+    }
+    let (differ, _) = common::diff(&keyhole, &quads, 0);
+    assert_eq!(differ, 0, "the keyhole face renders as the four quads");
+}
