@@ -32,6 +32,10 @@ pub const MAX_GRID_SIDE: u32 = 16;
 /// any useful resolution and keeps the traversal stack small.
 pub const MAX_OCTREE_DEPTH: u32 = 21;
 
+/// The octree overlay's deepest level unless one is asked for (the
+/// command line and the viewer alike).
+pub const DEFAULT_OVERLAY_DEPTH: u32 = 4;
+
 /// The octree's duplication limit: its children may hold at most this many
 /// times a node's references (8 never stops a split: eight children hold at
 /// most 8x).

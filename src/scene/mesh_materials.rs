@@ -95,7 +95,10 @@ pub(super) fn mesh_materials(
     mesh_path: &Path,
     files: &dyn FileSource,
 ) -> (Vec<u32>, Option<u32>) {
+    let notes_before = scene.load_notes.len();
     let entries = read_libraries(&mesh.libraries, mesh_path, files, &mut scene.load_notes);
+    // A library not read explains the names it would have defined.
+    let unread = scene.load_notes.len() > notes_before;
     for (k, n) in mtl::not_rendered(&entries) {
         *scene.not_rendered.entry(k).or_default() += n;
     }
@@ -142,8 +145,9 @@ pub(super) fn mesh_materials(
             _ => {
                 if slot > 0 {
                     scene.load_notes.push(format!(
-                        "{}: no material library defines `{name}`; its faces use the default material",
-                        mesh_path.display()
+                        "{}: no material library {}defines `{name}`; its faces use the default material",
+                        mesh_path.display(),
+                        if unread { "that could be read " } else { "" }
                     ));
                 }
                 *default.get_or_insert_with(|| {
