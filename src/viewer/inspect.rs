@@ -176,7 +176,9 @@ pub fn inspect_controls_ui(
     let mut overlay = inspect.overlay_depth.is_some();
     ui.horizontal(|ui| {
         ui.checkbox(&mut overlay, "Octree overlay");
-        let mut depth = inspect.overlay_depth.unwrap_or(crate::limits::DEFAULT_OVERLAY_DEPTH);
+        let mut depth = inspect
+            .overlay_depth
+            .unwrap_or(crate::limits::DEFAULT_OVERLAY_DEPTH);
         ui.label("to depth");
         ui.add(
             egui::DragValue::new(&mut depth)

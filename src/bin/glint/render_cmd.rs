@@ -257,7 +257,10 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
         }
     }
     let load_start = Instant::now();
-    let mut overlay_depth = args.overlay.map(|_| args.overlay_depth.unwrap_or(glint::limits::DEFAULT_OVERLAY_DEPTH));
+    let mut overlay_depth = args.overlay.map(|_| {
+        args.overlay_depth
+            .unwrap_or(glint::limits::DEFAULT_OVERLAY_DEPTH)
+    });
     let mut legend = true;
     let (mut scene, scene_name, mut settings, camera) = match (&args.from_png, &args.scene) {
         (Some(png), _) => {

@@ -43,7 +43,29 @@ impl Ramp {
 /// Height in pixels of the strip [`append_legend`] adds for an image `width` wide.
 pub fn legend_height(width: u32, legend: &Legend) -> u32 {
     let s = text_scale(width, legend);
-    6 + 10 + 4 + 2 * (7 * s + 3) + 2
+    let lines = caption_lines(width, legend, s).len() as u32;
+    6 + 10 + 4 + (1 + lines) * (7 * s + 3) + 2
+}
+
+/// The caption broken at spaces into lines that fit the image's width
+/// (a narrow image cut it off mid-word).
+fn caption_lines(width: u32, legend: &Legend, scale: u32) -> Vec<String> {
+    let room = width.saturating_sub(2 * margin(width));
+    let mut lines: Vec<String> = Vec::new();
+    for word in legend.caption.split(' ') {
+        match lines.last_mut() {
+            Some(line) if text_width(&format!("{line} {word}"), scale) <= room => {
+                line.push(' ');
+                line.push_str(word);
+            }
+            _ => lines.push(word.to_owned()),
+        }
+    }
+    lines
+}
+
+fn margin(width: u32) -> u32 {
+    4.min(width / 4)
 }
 
 /// Double-size text where the caption fits the image width, else single.
@@ -65,7 +87,7 @@ pub fn append_legend(rgb: &mut Vec<u8>, width: u32, height: u32, legend: &Legend
         height: new_height,
     };
     canvas.fill(0, height, width, strip, [24, 24, 24]);
-    let margin = 4.min(width / 4);
+    let margin = margin(width);
     let bar_y = height + 6;
     let bar_w = width.saturating_sub(2 * margin).max(1);
     for x in 0..bar_w {
@@ -84,7 +106,9 @@ pub fn append_legend(rgb: &mut Vec<u8>, width: u32, height: u32, legend: &Legend
         s,
         white,
     );
-    canvas.text(margin, line1 + 7 * s + 3, &legend.caption, s, white);
+    for (k, line) in caption_lines(width, legend, s).iter().enumerate() {
+        canvas.text(margin, line1 + (k as u32 + 1) * (7 * s + 3), line, s, white);
+    }
     new_height
 }
 
@@ -171,5 +195,29 @@ mod tests {
         let strip = &rgb[(w * h * 3) as usize..];
         assert!(strip.chunks(3).any(|p| p == [235, 235, 235]));
         assert!(strip.chunks(3).any(|p| p == viridis(1.0)));
+    }
+
+    /// A caption wider than the image wraps at spaces, every line within
+    /// the width (at 160 pixels it was cut off mid-word); a wide image
+    /// keeps it on one line.
+    #[test]
+    fn a_long_caption_wraps_to_the_width() {
+        let legend = Legend {
+            low: "0".into(),
+            high: "196".into(),
+            caption: "intersection tests per pixel, mean 13.0".into(),
+            ramp: Ramp::Viridis,
+        };
+        let s = text_scale(160, &legend);
+        let lines = caption_lines(160, &legend, s);
+        assert!(lines.len() > 1, "{lines:?}");
+        assert!(
+            lines
+                .iter()
+                .all(|l| text_width(l, s) <= 160 - 2 * margin(160)),
+            "{lines:?}"
+        );
+        assert_eq!(lines.join(" "), legend.caption);
+        assert_eq!(caption_lines(1000, &legend, 2).len(), 1);
     }
 }
