@@ -280,6 +280,7 @@ fn report(
     describe: serde_json::Value,
 ) -> serde_json::Value {
     let during = PreviewCounts {
+        sent: drag.counts_at_release.sent - drag.counts_before.sent,
         started: drag.counts_at_release.started - drag.counts_before.started,
         completed: drag.counts_at_release.completed - drag.counts_before.completed,
     };

@@ -84,6 +84,7 @@ struct Shared {
     cache: Mutex<PassCache<PassRecord>>,
     /// The preview in flight and the one waiting for it.
     previews: Mutex<PreviewQueue>,
+    previews_sent: AtomicU64,
     previews_started: AtomicU64,
     previews_completed: AtomicU64,
     /// The newest full job's generation ([`Worker::full_generation`]).
@@ -105,6 +106,9 @@ struct PreviewQueue {
 /// How the previews of a worker's life went (the orbit benchmark's counts).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct PreviewCounts {
+    /// Previews given a generation to render (sent to the worker, or
+    /// taken from the queue when the one before was done).
+    pub sent: u64,
     /// Previews the worker began rendering.
     pub started: u64,
     /// Previews that finished and went into the display buffer.
@@ -159,6 +163,7 @@ impl Worker {
             failure: Mutex::new(None),
             cache: Mutex::new(PassCache::default()),
             previews: Mutex::new(PreviewQueue::default()),
+            previews_sent: AtomicU64::new(0),
             previews_started: AtomicU64::new(0),
             previews_completed: AtomicU64::new(0),
             full_generation: AtomicU64::new(0),
@@ -223,6 +228,7 @@ impl Worker {
         if previews.in_flight.is_some() {
             previews.waiting = Some(job);
         } else {
+            self.shared.previews_sent.fetch_add(1, Ordering::SeqCst);
             previews.in_flight = Some(self.send(job));
         }
     }
@@ -230,6 +236,7 @@ impl Worker {
     /// How many previews were started and completed so far.
     pub fn preview_counts(&self) -> PreviewCounts {
         PreviewCounts {
+            sent: self.shared.previews_sent.load(Ordering::SeqCst),
             started: self.shared.previews_started.load(Ordering::SeqCst),
             completed: self.shared.previews_completed.load(Ordering::SeqCst),
         }
@@ -370,6 +377,7 @@ fn run(shared: Arc<Shared>, rx: Receiver<(u64, Job)>, threads: usize) {
             }
             match previews.waiting.take() {
                 Some(waiting) => {
+                    shared.previews_sent.fetch_add(1, Ordering::SeqCst);
                     generation = shared.generation.fetch_add(1, Ordering::SeqCst) + 1;
                     previews.in_flight = Some(generation);
                     job = waiting;

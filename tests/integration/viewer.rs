@@ -216,11 +216,16 @@ fn a_drag_cancels_no_preview_and_ends_on_the_newest_camera() {
         started,
         "every preview started was completed"
     );
+    // Every preview given a generation started: none was cancelled
+    // unstarted by a newer one. (Counting generations instead also counted
+    // a full job when, under load, a frame near the press was not yet a
+    // drag: that failed once in a full run.)
     assert_eq!(
-        h.state().worker().generation() - generation_before,
+        counts.sent - before.sent,
         started,
-        "no generation went to a preview that never started"
+        "no preview was sent that never started"
     );
+    assert!(h.state().worker().generation() - generation_before >= started);
     assert!(
         h.state()
             .worker()
