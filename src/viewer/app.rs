@@ -212,6 +212,19 @@ impl GlintApp {
                     super::walk_view::ray_names(inspection).join(", ")
                 );
             }
+            // A step past the walk's end would show its end: say so.
+            let steps = app.inspect.inspection.as_ref().and_then(|inspection| {
+                let ray = super::walk_view::walked_ray(inspection, &target)?;
+                ray.query.and_then(|q| q.walk.as_ref()).map(Vec::len)
+            });
+            if let (Some(step), Some(steps)) = (step, steps)
+                && step > steps
+            {
+                anyhow::bail!(
+                    "--walk-step {step}: the walk of {} has {steps} steps",
+                    target.name()
+                );
+            }
             app.inspect.walk.target = Some(target);
             app.inspect.walk.shown = step.unwrap_or(usize::MAX);
         }

@@ -154,10 +154,11 @@ fn an_image_side_past_the_viewers_limit_is_refused_in_place() {
 }
 
 /// `--walk` to a ray the inspected pixel does not have is refused, with
-/// the rays it has; one it has is taken.
+/// the rays it has; one it has is taken; `--walk-step` past its walk is
+/// refused too.
 #[test]
 fn a_walk_to_a_ray_the_pixel_lacks_is_refused_with_its_rays() {
-    let open = |walk: &str| {
+    let open_at = |walk: &str, step: Option<usize>| {
         let path: Vec<&str> = walk.split('/').skip(1).collect();
         let mut target = glint::viewer::WalkTarget::default();
         let mut parts = path.iter();
@@ -172,12 +173,13 @@ fn a_walk_to_a_ray_the_pixel_lacks_is_refused_with_its_rays() {
             glint::viewer::SceneSource::File(common::repo_path("scenes/sphere.toml")),
             glint::viewer::ViewerOptions {
                 inspect: Some((320, 240)),
-                walk: Some((target, None)),
+                walk: Some((target, step)),
                 ..Default::default()
             },
             || {},
         )
     };
+    let open = |walk: &str| open_at(walk, None);
     // The centre pixel sees the sphere: an eye ray and its shadow ray.
     assert!(open("eye").is_ok());
     assert!(open("eye/shadow/0").is_ok());
@@ -186,6 +188,16 @@ fn a_walk_to_a_ray_the_pixel_lacks_is_refused_with_its_rays() {
         error.starts_with(
             "--walk eye/7/shadow/3: pixel 320,240 has no such ray; its rays: eye, eye/shadow/0"
         ),
+        "{error}"
+    );
+    // A step past the walk's end is refused with the walk's length.
+    assert!(open_at("eye", Some(1)).is_ok());
+    let error = open_at("eye", Some(999))
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(
+        error.starts_with("--walk-step 999: the walk of eye has "),
         "{error}"
     );
 }
