@@ -652,3 +652,14 @@ fn a_scene_as_the_first_argument_opens_the_viewer() {
         "{err}"
     );
 }
+
+/// `--max-depth` outside 1 to 64 is refused alike at both ends (0 was a
+/// usage error, exit 2; 65 a render error, exit 1).
+#[test]
+fn max_depth_is_refused_alike_at_both_ends() {
+    for depth in ["0", "65"] {
+        let out = glint(&["render", &scene(), "-o", "x.png", "--max-depth", depth]);
+        assert_eq!(out.status.code(), Some(2), "--max-depth {depth}");
+        assert!(String::from_utf8_lossy(&out.stderr).contains("expected a ray depth from 1 to 64"));
+    }
+}

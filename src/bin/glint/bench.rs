@@ -31,7 +31,7 @@ pub struct BenchArgs {
     #[arg(long, value_parser = crate::common::parse_aa, conflicts_with = "samples")]
     pub aa: Option<glint::settings::AntiAliasing>,
     /// Longest ray path (default: each scene's own; the SPD protocol fixes 5).
-    #[arg(long, value_parser = parse_positive)]
+    #[arg(long, value_parser = crate::common::ray_depth)]
     pub max_depth: Option<u32>,
     #[command(flatten)]
     pub rules: RulesArgs,

@@ -208,6 +208,18 @@ pub fn octree_depth(text: &str) -> Result<u32, String> {
     }
 }
 
+/// A `--max-depth`: refused by the command-line parser whether it is 0 or
+/// past the limit (65 was refused later, with another exit code).
+pub fn ray_depth(text: &str) -> Result<u32, String> {
+    let max = glint::limits::MAX_RAY_DEPTH;
+    match text.trim().parse::<u32>() {
+        Ok(d) if (1..=max).contains(&d) => Ok(d),
+        _ => Err(format!(
+            "expected a ray depth from 1 to {max}, got `{text}`"
+        )),
+    }
+}
+
 /// Octree parameters on the command line; unset ones keep the scene's.
 #[derive(clap::Args, Clone, Copy, Debug, Default)]
 pub struct OctreeArgs {

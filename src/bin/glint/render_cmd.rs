@@ -48,7 +48,7 @@ pub struct RenderArgs {
     #[arg(long, value_parser = crate::common::parse_aa, conflicts_with = "samples")]
     pub aa: Option<glint::settings::AntiAliasing>,
     /// Longest ray path; the eye ray is depth 1 (the SPD protocol fixes 5).
-    #[arg(long, value_parser = parse_positive)]
+    #[arg(long, value_parser = crate::common::ray_depth)]
     pub max_depth: Option<u32>,
     #[command(flatten)]
     pub rules: RulesArgs,
