@@ -27,7 +27,7 @@ pub use png_file::{read_record, read_record_bytes};
 pub use record::{
     KEY_SCENE, KEY_SCENE_PATH, KEY_SCENE_SHA256, KEY_SETTINGS, KEY_VERSION, MAX_EMBEDDED_SCENE,
     MAX_SCENE_TEXT, RecordedCamera, RecordedSettings, RenderRecord, SCENE_CHUNK, SceneEdits,
-    sha256_hex,
+    absolute_name, sha256_hex,
 };
 
 use crate::accel::Octree;
@@ -133,7 +133,7 @@ pub fn restore(png: &Path) -> Result<Restored, ExportError> {
         let now = scene
             .files_read
             .iter()
-            .find(|f| record::absolute_name(&f.path) == file.path);
+            .find(|f| absolute_name(&f.path) == file.path);
         if now.is_none_or(|f| f.sha256 != file.sha256) {
             notes.push(format!(
                 "{} has changed since {} was made (its SHA-256 differs from the recorded one): \

@@ -100,79 +100,71 @@ pub fn parse_obj(
         let listed = &data.corners[f.start as usize..(f.start + f.len) as usize];
         // A face with a hole written as one bridged polygon: triangulated
         // as the ring it describes (removing the repeats cut a wedge out).
-        if listed.len() >= 8
-            && let Some(pieces) = keyhole_face(listed, &positions)
-        {
-            let has_normals = listed.iter().all(|&(_, n)| n != NO_NORMAL);
-            any_normals |= has_normals;
-            for t in pieces {
-                triangles.push(t.map(|k| positions[listed[k as usize].0 as usize]));
-                triangle_normals.push(if has_normals {
-                    t.map(|k| normals[listed[k as usize].1 as usize])
-                } else {
-                    [DVec3::ZERO; 3]
-                });
-                triangle_materials.push(f.material);
-                if !data.colors.is_empty() {
-                    let [ca, cb, cc] = t.map(|k| color_of(listed[k as usize].0));
-                    triangle_colors.push(ca.zip(cb).zip(cc).map(|((a, b), c)| [a, b, c]));
-                }
-            }
-            continue;
-        }
-        for &corner in listed {
-            if !face.iter().any(|&(p, _)| p == corner.0) {
-                face.push(corner);
-            }
-        }
-        // Counted once: as short if too few corners are left, else as a
-        // face whose repeats were removed.
-        if face.len() < 3 {
-            skipped.short_faces += 1;
-            continue;
-        }
-        if face.len() < listed.len() {
-            skipped.faces_with_repeated_vertices += 1;
-        }
-        let corners: Vec<DVec3> = face.iter().map(|&(p, _)| positions[p as usize]).collect();
-        let pieces = if face.len() == 3 {
-            vec![[0, 1, 2]]
-        } else {
-            // Faces are ear-clipped, not fanned: concave faces exist.
-            let folded = |defect| match defect {
-                PolygonDefect::NotSimple => folded_quad(&corners),
-                PolygonDefect::ZeroArea => None,
-            };
-            match triangulate(&corners).map_err(|defect| (defect, folded(defect))) {
-                Ok(t) => t,
-                // A quad whose outline crosses itself (scanners write
-                // them where the surface folds): its two triangles.
-                Err((_, Some(t))) => {
-                    folded_quads += 1;
-                    t
-                }
-                Err((defect, None)) => {
-                    dropped_polygons.record(defect);
-                    if dropped_lines.len() < 5 {
-                        dropped_lines.push(f.line);
+        let keyhole = (listed.len() >= 8)
+            .then(|| keyhole_face(listed, &positions))
+            .flatten();
+        // The triangles, as indices into the corners they use.
+        let (pieces, used): (Vec<[u32; 3]>, &[(u32, u32)]) = match keyhole {
+            Some(pieces) => (pieces, listed),
+            None => {
+                for &corner in listed {
+                    if !face.iter().any(|&(p, _)| p == corner.0) {
+                        face.push(corner);
                     }
+                }
+                // Counted once: as short if too few corners are left, else
+                // as a face whose repeats were removed.
+                if face.len() < 3 {
+                    skipped.short_faces += 1;
                     continue;
                 }
+                if face.len() < listed.len() {
+                    skipped.faces_with_repeated_vertices += 1;
+                }
+                let corners: Vec<DVec3> =
+                    face.iter().map(|&(p, _)| positions[p as usize]).collect();
+                let pieces = if face.len() == 3 {
+                    vec![[0, 1, 2]]
+                } else {
+                    // Faces are ear-clipped, not fanned: concave faces exist.
+                    let folded = |defect| match defect {
+                        PolygonDefect::NotSimple => folded_quad(&corners),
+                        PolygonDefect::ZeroArea => None,
+                    };
+                    match triangulate(&corners).map_err(|defect| (defect, folded(defect))) {
+                        Ok(t) => t,
+                        // A quad whose outline crosses itself (scanners
+                        // write them where the surface folds): its two
+                        // triangles.
+                        Err((_, Some(t))) => {
+                            folded_quads += 1;
+                            t
+                        }
+                        Err((defect, None)) => {
+                            dropped_polygons.record(defect);
+                            if dropped_lines.len() < 5 {
+                                dropped_lines.push(f.line);
+                            }
+                            continue;
+                        }
+                    }
+                };
+                (pieces, &face[..])
             }
         };
-        let has_normals = face.iter().all(|&(_, n)| n != NO_NORMAL);
+        let has_normals = used.iter().all(|&(_, n)| n != NO_NORMAL);
         any_normals |= has_normals;
-        for [a, b, c] in pieces {
-            let (a, b, c) = (a as usize, b as usize, c as usize);
-            triangles.push([corners[a], corners[b], corners[c]]);
+        for t in pieces {
+            let corners = t.map(|k| used[k as usize]);
+            triangles.push(corners.map(|(p, _)| positions[p as usize]));
             triangle_normals.push(if has_normals {
-                [a, b, c].map(|k| normals[face[k].1 as usize])
+                corners.map(|(_, n)| normals[n as usize])
             } else {
                 [DVec3::ZERO; 3]
             });
             triangle_materials.push(f.material);
             if !data.colors.is_empty() {
-                let [ca, cb, cc] = [a, b, c].map(|k| color_of(face[k].0));
+                let [ca, cb, cc] = corners.map(|(p, _)| color_of(p));
                 triangle_colors.push(ca.zip(cb).zip(cc).map(|((a, b), c)| [a, b, c]));
             }
         }

@@ -10,10 +10,7 @@ use std::process::{Command, Output};
 const PNG_SIGNATURE: &[u8] = b"\x89PNG\r\n\x1a\n";
 
 fn glint(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_glint"))
-        .args(args)
-        .output()
-        .unwrap()
+    common::glint_output(args)
 }
 
 fn scene() -> String {

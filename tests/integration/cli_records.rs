@@ -8,10 +8,7 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 fn glint(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_glint"))
-        .args(args)
-        .output()
-        .unwrap()
+    common::glint_output(args)
 }
 
 /// A closed standard error (`glint render ... 2>&1 | true`) loses the

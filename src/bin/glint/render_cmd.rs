@@ -410,8 +410,7 @@ fn save(
     let recorded_path = if job.scene_name == glint::scene::builtin::NAME {
         job.scene_name.clone()
     } else {
-        std::fs::canonicalize(&job.scene_name)
-            .map_or_else(|_| job.scene_name.clone(), |p| p.display().to_string())
+        glint::export::absolute_name(std::path::Path::new(&job.scene_name))
     };
     let mut record = glint::export::RenderRecord::new(&job.scene, &recorded_path, &job.camera, *s);
     record.settings.legend = job.legend;

@@ -12,6 +12,14 @@ use glint::stats::RenderCounts;
 #[cfg(feature = "gui")]
 pub mod viewer;
 
+/// Runs the `glint` binary with `args` and returns what it printed.
+pub fn glint_output(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_glint"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
 pub fn repo_path(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
 }
