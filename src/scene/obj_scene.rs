@@ -7,6 +7,7 @@ use std::path::Path;
 
 use crate::camera::CameraSpec;
 use crate::math::{Aabb, DVec3};
+use crate::shapes::Shape;
 
 use super::file_source::FileSource;
 use super::model::{Scene, SceneError};
@@ -79,7 +80,9 @@ pub(super) fn load(path: &Path, files: &dyn FileSource) -> Result<Scene, SceneEr
         },
         other => other,
     })?;
-    let (camera, light) = frame(scene.geometry_bounds()).ok_or_else(|| SceneError::Model {
+    let bounds = scene.geometry_bounds();
+    let axes = model_axes(&scene.shapes, bounds);
+    let (camera, light) = frame(bounds, axes).ok_or_else(|| SceneError::Model {
         path: path.to_owned(),
         message: "the model's coordinates are too large to frame with a camera \
                   (the camera's distance from it would overflow a double)"
@@ -94,15 +97,85 @@ pub(super) fn load(path: &Path, files: &dyn FileSource) -> Result<Scene, SceneEr
     Ok(scene)
 }
 
-/// A camera that frames `bounds` and a light over its shoulder: seen from
-/// the front (+z, the usual forward of OBJ exports) a little from above,
-/// unless the model is far thinner along x or y: then from its broad side
-/// (+x), or from above (a floor or a terrain flat in y), never edge-on (a
-/// model in a plane containing the z axis showed nothing). Far enough
-/// that the bounding sphere fits the view. `None` if that place
-/// is not a finite number (a model reaching 1e300), or so far that the
-/// camera's own length computations overflow (a model 1e154 across).
-fn frame(bounds: Aabb) -> Option<(CameraSpec, DVec3)> {
+/// The model's own axes: which way is up, which side is its front, and
+/// the one across. OBJ has no up axis of its own; exporters mostly write
+/// +y up with the model facing +z (Blender's and 3ds Max's defaults), but
+/// scans and CAD or 3D-printing exports are +z up, facing -y (Blender's
+/// front view looks along +y).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct ModelAxes {
+    side: DVec3,
+    up: DVec3,
+    front: DVec3,
+}
+
+const Y_UP: ModelAxes = ModelAxes {
+    side: DVec3::X,
+    up: DVec3::Y,
+    front: DVec3::Z,
+};
+const Z_UP: ModelAxes = ModelAxes {
+    side: DVec3::X,
+    up: DVec3::Z,
+    front: DVec3::NEG_Y,
+};
+
+/// The up axis the model's content suggests: +z when the model stands on
+/// a flat base at its lowest z (faces perpendicular to z there covering at
+/// least 2 % of its footprint) that has no match at its top (a box or a
+/// slab is flat at both ends and says nothing) and no comparable base at
+/// its lowest y; +y, OBJ's convention, otherwise. A statue's plinth, a
+/// 3D-print's bed face or a building's ground slab is such a base; the
+/// flat butt of a rifle lying along z is not, its muzzle end being as flat.
+fn model_axes(shapes: &[Shape], bounds: Aabb) -> ModelAxes {
+    let extent = bounds.max - bounds.min;
+    // Area of faces perpendicular to `axis` lying at its low and high end,
+    // as fractions of the model's footprint across that axis.
+    let flat_ends = |axis: usize| {
+        let across = extent[(axis + 1) % 3] * extent[(axis + 2) % 3];
+        let tolerance = 0.01 * extent[axis];
+        let (mut low, mut high) = (0.0, 0.0);
+        if !(across > 0.0 && across.is_finite()) {
+            return (0.0, 0.0);
+        }
+        for shape in shapes {
+            let Shape::Triangle(t) = shape else { continue };
+            let [a, b, c] = t.vertices;
+            let normal = (b - a).cross(c - a);
+            let area = 0.5 * normal.length();
+            if !(area.is_finite() && normal[axis].abs() > 0.99 * 2.0 * area) {
+                continue;
+            }
+            let (lo, hi) = (
+                a[axis].min(b[axis]).min(c[axis]),
+                a[axis].max(b[axis]).max(c[axis]),
+            );
+            // A flat model's faces lie at both ends: no base.
+            if hi <= bounds.min[axis] + tolerance {
+                low += area;
+            }
+            if lo >= bounds.max[axis] - tolerance {
+                high += area;
+            }
+        }
+        (low / across, high / across)
+    };
+    let (base_z, top_z) = flat_ends(2);
+    let (base_y, _) = flat_ends(1);
+    if base_z >= 0.02 && base_z > 2.0 * top_z && base_z > 2.0 * base_y {
+        Z_UP
+    } else {
+        Y_UP
+    }
+}
+
+/// A camera that frames `bounds` and a light over its shoulder, seen from
+/// the model's broad side a little from above (`view_direction`), with the
+/// up axis the model suggests (`model_axes`). Far enough that the bounding
+/// sphere fits the view. `None` if that place is not a finite number (a
+/// model reaching 1e300), or so far that the camera's own length
+/// computations overflow (a model 1e154 across).
+fn frame(bounds: Aabb, axes: ModelAxes) -> Option<(CameraSpec, DVec3)> {
     // A model with no faces (only lines or points): the unit box.
     let bounds = if bounds.is_empty() {
         Aabb::new(DVec3::splat(-1.0), DVec3::splat(1.0))
@@ -122,31 +195,47 @@ fn frame(bounds: Aabb) -> Option<(CameraSpec, DVec3)> {
     // A point model, or one far smaller than its distance from the origin,
     // still needs an eye apart from the lookat point.
     let radius = radius.max(center.abs().max_element() * 1e-9).max(1e-150);
-    let direction = view_direction(extent);
+    let direction = view_direction(extent, axes);
     let distance = radius / (0.5 * FOV.to_radians()).sin() * 1.05;
     let camera = CameraSpec {
         eye: center + direction * distance,
         lookat: center,
-        up: DVec3::Y,
+        up: axes.up,
         fov: FOV,
     };
-    let light = center + DVec3::new(-0.5, 1.0, 0.8).normalize() * (distance * 1.5);
+    // Over the camera's left shoulder, whichever side it looks from.
+    let right = axes.up.cross(direction).normalize();
+    let over_shoulder = (direction * 0.8 + axes.up - right * 0.5).normalize();
+    let light = center + over_shoulder * (distance * 1.5);
     (camera.eye.is_finite() && light.is_finite() && camera.check().is_ok())
         .then_some((camera, light))
 }
 
-/// Where the camera looks from, seen from the model: +z a little from
-/// above, unless x or y is under half of z's extent (the model's broad
-/// side then faces that axis). OBJ's up is +y, so a model flat in y is
-/// seen steeply from above rather than straight down the up vector.
-fn view_direction(extent: DVec3) -> DVec3 {
-    let thin = |axis: f64| axis < 0.5 * extent.z;
-    let direction = if thin(extent.x) && extent.x <= extent.y {
-        DVec3::new(1.0, 0.25, 0.0)
-    } else if thin(extent.y) {
-        DVec3::new(0.0, 1.0, 0.6)
+/// Where the camera looks from, seen from the model: its broad side, a
+/// little off square (so depth shows) and a little from above. The front
+/// is that side unless the model is clearly broader seen from the side (a
+/// car or a cow modelled facing the front would show its nose or its
+/// tail). A model flat across its up axis (a floor, a terrain, a city
+/// plan) is seen from higher up, never edge-on; a flat sheet standing
+/// upright is seen square on.
+fn view_direction(extent: DVec3, axes: ModelAxes) -> DVec3 {
+    let along = |axis: DVec3| extent.dot(axis.abs());
+    let (side, up, front) = (along(axes.side), along(axes.up), along(axes.front));
+    // A sheet (a cut-out, a drawing, a single face) facing the camera is
+    // seen square on: off square it only shrinks.
+    let off_square = |depth: f64| {
+        if depth < 0.05 * extent.max_element() {
+            0.0
+        } else {
+            1.0
+        }
+    };
+    let direction = if up < 0.5 * side.min(front) {
+        axes.front + 0.3 * axes.side + 0.8 * axes.up
+    } else if side < 0.8 * front {
+        axes.side + off_square(side) * (0.35 * axes.front + 0.3 * axes.up)
     } else {
-        DVec3::new(0.0, 0.25, 1.0)
+        axes.front + off_square(front) * (0.35 * axes.side + 0.3 * axes.up)
     };
     direction.normalize()
 }
@@ -224,7 +313,7 @@ mod tests {
         // Bounds the camera would have to stand beyond the largest double
         // to see (no triangle reaches them: a face this size overflows its
         // area and is dropped at load).
-        assert!(frame(Aabb::new(DVec3::ZERO, DVec3::splat(1.5e308))).is_none());
+        assert!(frame(Aabb::new(DVec3::ZERO, DVec3::splat(1.5e308)), Y_UP).is_none());
         // A face 1e154 across keeps a finite area, but a camera that sees
         // it stands where eye - lookat has no finite length: refused with
         // the reason, not written as a scene that cannot load again (found
@@ -235,5 +324,137 @@ mod tests {
         )
         .unwrap_err();
         assert!(e.to_string().contains("too large to frame"), "{e}");
+    }
+
+    /// The OBJ text of the box `min`..`max`, without the faces `omit`
+    /// names (`-z` for its bottom if z is up, `+x`, ...).
+    fn box_obj(min: DVec3, max: DVec3, omit: &[&str]) -> String {
+        let mut text = String::new();
+        for i in 0..8 {
+            let pick = |bit: usize, axis: usize| if i & bit == 0 { min[axis] } else { max[axis] };
+            text += &format!("v {} {} {}\n", pick(1, 0), pick(2, 1), pick(4, 2));
+        }
+        // Vertex numbers of each side, by the side's outward axis.
+        for (name, face) in [
+            ("-x", "1 5 7 3"),
+            ("+x", "2 4 8 6"),
+            ("-y", "1 2 6 5"),
+            ("+y", "3 7 8 4"),
+            ("-z", "1 3 4 2"),
+            ("+z", "5 6 8 7"),
+        ] {
+            if !omit.contains(&name) {
+                text += &format!("f {face}\n");
+            }
+        }
+        text
+    }
+
+    /// The model's faces appended to `base` (its vertex numbers shifted).
+    fn with(base: String, more: &str) -> String {
+        let shift = base.lines().filter(|l| l.starts_with("v ")).count();
+        let more: String = more
+            .lines()
+            .map(|l| match l.strip_prefix("f ") {
+                Some(face) => {
+                    let ids: Vec<String> = face
+                        .split_whitespace()
+                        .map(|n| (n.parse::<usize>().unwrap() + shift).to_string())
+                        .collect();
+                    format!("f {}\n", ids.join(" "))
+                }
+                None => format!("{l}\n"),
+            })
+            .collect();
+        base + &more
+    }
+
+    fn framed(obj: String) -> CameraSpec {
+        struct One(String);
+        impl FileSource for One {
+            fn read(&self, _: &Path) -> std::io::Result<Vec<u8>> {
+                Ok(self.0.clone().into_bytes())
+            }
+        }
+        load(Path::new("m.obj"), &One(obj)).unwrap().camera
+    }
+
+    /// Issue 36 point 10: a statue on a plinth written z-up (a scan's, a
+    /// 3D print's habit) is seen upright, from its front (-y) a little from
+    /// above; the same statue written y-up keeps +y up and the +z front.
+    #[test]
+    fn the_up_axis_is_the_one_the_model_stands_on() {
+        // A plinth without a top (the figure stands on it) and a spire.
+        let plinth = box_obj(
+            DVec3::new(-1.0, -1.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.3),
+            &["+z"],
+        );
+        let spire = "v -0.5 -0.5 0.3\nv 0.5 -0.5 0.3\nv 0.5 0.5 0.3\nv -0.5 0.5 0.3\nv 0 0 3\n\
+                     f 1 2 5\nf 2 3 5\nf 3 4 5\nf 4 1 5\n";
+        let z_up = with(plinth, spire);
+        let camera = framed(z_up.clone());
+        assert_eq!(camera.up, DVec3::Z);
+        let seen_from = camera.eye - camera.lookat;
+        assert!(seen_from.y < 0.0 && seen_from.z > 0.0, "{seen_from}");
+        assert!(seen_from.y.abs() > seen_from.x.abs(), "{seen_from}");
+        // The same statue with y and z swapped (and the winding turned).
+        let y_up: String = z_up
+            .lines()
+            .map(|l| match l.strip_prefix("v ") {
+                Some(v) => {
+                    let c: Vec<&str> = v.split_whitespace().collect();
+                    format!("v {} {} {}\n", c[0], c[2], c[1])
+                }
+                None => format!("{l}\n"),
+            })
+            .collect();
+        let camera = framed(y_up);
+        assert_eq!(camera.up, DVec3::Y);
+        let seen_from = camera.eye - camera.lookat;
+        assert!(seen_from.z > 0.0 && seen_from.y > 0.0, "{seen_from}");
+        // A beam lying along z, flat at both ends (a rifle's butt and
+        // muzzle), stands on nothing: +y stays up, and its long side
+        // faces the camera.
+        let camera = framed(box_obj(
+            DVec3::new(-0.2, -0.5, -5.0),
+            DVec3::new(0.2, 0.5, 5.0),
+            &[],
+        ));
+        assert_eq!(camera.up, DVec3::Y);
+        let seen_from = camera.eye - camera.lookat;
+        assert!(seen_from.x > 2.0 * seen_from.z.abs(), "{seen_from}");
+        // A cube is flat everywhere: the convention, seen from the front.
+        let camera = framed(box_obj(DVec3::ZERO, DVec3::ONE, &[]));
+        assert_eq!(camera.up, DVec3::Y);
+        let seen_from = camera.eye - camera.lookat;
+        assert!(seen_from.z > 2.0 * seen_from.x.abs(), "{seen_from}");
+    }
+
+    /// A z-up model that is wide and low (a house on its ground slab) is
+    /// seen from above its front, not straight down; a sheet standing
+    /// upright is seen square on, not obliquely.
+    #[test]
+    fn flat_models_are_seen_from_above_and_sheets_square_on() {
+        let ground = box_obj(
+            DVec3::new(-10.0, -8.0, 0.0),
+            DVec3::new(10.0, 8.0, 0.2),
+            &[],
+        );
+        let house = box_obj(
+            DVec3::new(-3.0, -2.0, 0.2),
+            DVec3::new(3.0, 2.0, 3.0),
+            &["-z"],
+        );
+        let camera = framed(with(ground, &house));
+        assert_eq!(camera.up, DVec3::Z);
+        let seen_from = (camera.eye - camera.lookat).normalize();
+        assert!(
+            seen_from.y < 0.0 && seen_from.z > 0.4 && seen_from.z < 0.9,
+            "{seen_from}"
+        );
+        let sheet = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3 4\n".to_string();
+        let camera = framed(sheet);
+        assert_eq!((camera.eye - camera.lookat).normalize(), DVec3::Z);
     }
 }
