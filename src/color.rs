@@ -41,6 +41,18 @@ impl ColorConvention {
         }
     }
 
+    /// A shaded value as the 8-bit channel written for it: exactly
+    /// `to_byte(self.encode(x))`, but a linear value is looked up among
+    /// the 255 linear values at which the sRGB byte steps up (eight
+    /// comparisons instead of `powf` for every channel of every pixel).
+    #[inline]
+    pub fn byte(self, x: f64) -> u8 {
+        match self {
+            ColorConvention::Linear => srgb_byte(x),
+            ColorConvention::Display => to_byte(x),
+        }
+    }
+
     /// [`ColorConvention::encode`] of each channel.
     #[inline]
     pub fn encode_rgb(self, c: Color) -> DVec3 {
@@ -105,9 +117,84 @@ pub fn to_byte(x: f64) -> u8 {
     (whole + (y - whole as f64 >= 0.5) as u32) as u8
 }
 
+/// `to_byte(linear_to_srgb(x))` by table: the byte is the number of steps
+/// at or below `x` (both are monotonic in `x`; NaN and values below the
+/// first step give 0, as the formula does).
+#[inline]
+fn srgb_byte(x: f64) -> u8 {
+    let steps = srgb_steps();
+    let mut k = 0;
+    for half in [128, 64, 32, 16, 8, 4, 2, 1] {
+        if x >= steps[k + half] {
+            k += half;
+        }
+    }
+    k as u8
+}
+
+/// `steps[k]`: the least linear value whose sRGB byte is at least `k`
+/// (`steps[0]` is unused), found once by bisecting the doubles of [0, 1]
+/// in their bit order with the formula itself, so the table cannot
+/// disagree with it.
+fn srgb_steps() -> &'static [f64; 256] {
+    static STEPS: std::sync::OnceLock<[f64; 256]> = std::sync::OnceLock::new();
+    STEPS.get_or_init(|| {
+        let byte = |bits: u64| to_byte(linear_to_srgb(f64::from_bits(bits)));
+        let mut steps = [f64::NEG_INFINITY; 256];
+        for (k, step) in steps.iter_mut().enumerate().skip(1) {
+            // Least `bits` in [0, bits of 1.0] with byte >= k: byte(1.0)
+            // is 255, so one exists.
+            let (mut lo, mut hi) = (0u64, 1.0f64.to_bits());
+            while lo < hi {
+                let mid = lo + (hi - lo) / 2;
+                if byte(mid) as usize >= k {
+                    hi = mid;
+                } else {
+                    lo = mid + 1;
+                }
+            }
+            *step = f64::from_bits(lo);
+        }
+        steps
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The table gives the formula's byte everywhere: at, just below and
+    /// just above every step, on a fine grid, and for values outside
+    /// [0, 1], infinities and NaN.
+    #[test]
+    fn the_srgb_table_is_the_formula_bit_for_bit() {
+        let formula = |x: f64| to_byte(linear_to_srgb(x));
+        let mut cases = vec![
+            f64::NAN,
+            -f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            -0.0,
+            0.0,
+        ];
+        cases.extend([-1.0, 1.0, 1.5, f64::MIN_POSITIVE, 5e-324, 1e-300]);
+        for &step in &srgb_steps()[1..] {
+            let bits = step.to_bits();
+            cases.extend((bits.saturating_sub(3)..=bits + 3).map(f64::from_bits));
+        }
+        cases.extend((0..=100_000).map(|k| k as f64 / 100_000.0));
+        for x in cases {
+            assert_eq!(ColorConvention::Linear.byte(x), formula(x), "x = {x:e}");
+            assert_eq!(ColorConvention::Display.byte(x), to_byte(x), "x = {x:e}");
+        }
+        // Monotonic steps, each a real step of the formula.
+        let steps = srgb_steps();
+        for k in 1..256 {
+            assert!(steps[k] > steps[k - 1], "{k}");
+            assert_eq!(formula(steps[k]) as usize, k);
+            assert_eq!(formula(steps[k].next_down()) as usize, k - 1);
+        }
+    }
 
     #[test]
     fn to_byte_rounds_as_f64_round_does() {

@@ -224,12 +224,12 @@ impl Frame {
     /// normalised to the visible range.
     pub fn to_rgb8(&self) -> Vec<u8> {
         // Frame-wide values first, then every pixel on its own, in parallel
-        // (the sRGB encoding of an 800x600 frame is 1.4 million powers).
+        // (the sRGB encoding of an 800x600 frame is 1.4 million table lookups).
         let near = (self.view == ViewMode::Depth).then(|| nearest_depth(&self.pixels));
         let range = self.cost_summary().map_or((0.0, 0.0), |c| (c.min, c.max));
         let encode = |p: &DVec3| -> [u8; 3] {
             match self.view {
-                ViewMode::Shaded => [p.x, p.y, p.z].map(|c| to_byte(self.colors.encode(c))),
+                ViewMode::Shaded => [p.x, p.y, p.z].map(|c| self.colors.byte(c)),
                 ViewMode::Normals => [p.x, p.y, p.z].map(to_byte),
                 ViewMode::Depth => [to_byte(depth_shade(*p, near.unwrap_or(0.0))); 3],
                 ViewMode::Cost | ViewMode::CostSteps => {

@@ -564,8 +564,7 @@ fn print_ray_tree(job: &Prepared, x: u32, y: u32) -> Result<()> {
         .with_context(|| format!("cannot render {}", job.scene_name))?;
     let tree = renderer.ray_tree(x, y);
     let color = glam::DVec3::from_array(tree.color);
-    let srgb8 =
-        [color.x, color.y, color.z].map(|c| glint::color::to_byte(settings.colors.encode(c)));
+    let srgb8 = [color.x, color.y, color.z].map(|c| settings.colors.byte(c));
     let out = TraceJson {
         scene: job.scene_name.clone(),
         pixel: [x, y],
