@@ -5,7 +5,7 @@
 // Lane loops index several arrays by the same lane number.
 #![allow(clippy::needless_range_loop)]
 
-use crate::shapes::{PacketHits, PreparedRay, RayPacket, Shape, ShapeHit};
+use crate::shapes::{PacketHits, PreparedRay, RayPacket, Shape, ShapeHit, probe_past, wins};
 use crate::simd::F64s;
 use crate::stats::Counter;
 
@@ -148,7 +148,7 @@ pub(crate) fn test_closest<C: Counter>(
     // `limit` is exclusive in `intersect`; an equal t with a lower index
     // also wins, so look just past it.
     let probe = if best.is_some() {
-        next_up(limit)
+        probe_past(limit)
     } else {
         limit
     };
@@ -157,21 +157,11 @@ pub(crate) fn test_closest<C: Counter>(
     if let Some(hit) = found {
         let better = match best {
             None => true,
-            Some(b) => hit.t < b.hit.t || (hit.t == b.hit.t && index < b.shape),
+            Some(b) => wins(hit.t, index, b.hit.t, b.shape),
         };
         if better {
             *best = Some(ClosestHit { shape: index, hit });
         }
-    }
-}
-
-/// The smallest `f64` above `x` (for finite, non-negative `x`).
-#[inline(always)]
-fn next_up(x: f64) -> f64 {
-    if x.is_finite() {
-        f64::from_bits(x.to_bits() + 1)
-    } else {
-        x
     }
 }
 

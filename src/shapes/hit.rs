@@ -5,6 +5,52 @@
 
 use crate::math::{DVec3, Ray};
 
+/// Runs `$body` with the axes `(KX, KY, KZ)` of the watertight test's
+/// permutation `$permutation` bound as constants (a vector indexed by a
+/// variable costs a match per access): `KZ` the dominant axis, the others
+/// in cyclic order, swapped when the dominant component is negative. The
+/// one table of the six permutations, for the single ray's and the
+/// packet's shear and triangle tests alike.
+macro_rules! along_axes {
+    ($permutation:expr, |$kx:ident, $ky:ident, $kz:ident| $body:expr) => {
+        match $permutation {
+            0 => along_axes!(@bind 1, 2, 0, $kx, $ky, $kz, $body),
+            1 => along_axes!(@bind 2, 1, 0, $kx, $ky, $kz, $body),
+            2 => along_axes!(@bind 2, 0, 1, $kx, $ky, $kz, $body),
+            3 => along_axes!(@bind 0, 2, 1, $kx, $ky, $kz, $body),
+            4 => along_axes!(@bind 0, 1, 2, $kx, $ky, $kz, $body),
+            _ => along_axes!(@bind 1, 0, 2, $kx, $ky, $kz, $body),
+        }
+    };
+    (@bind $x:literal, $y:literal, $z:literal, $kx:ident, $ky:ident, $kz:ident, $body:expr) => {{
+        const $kx: usize = $x;
+        const $ky: usize = $y;
+        const $kz: usize = $z;
+        $body
+    }};
+}
+pub(crate) use along_axes;
+
+/// The closest-hit tie rule: a hit at `t` on shape `index` beats the best
+/// so far (`best_t`, `best_index`) if it is closer, or as close on a lower
+/// index, so the answer never depends on the order of the tests (single
+/// rays and packets, octree and brute force, give the same shape).
+#[inline(always)]
+pub fn wins(t: f64, index: u32, best_t: f64, best_index: u32) -> bool {
+    t < best_t || (t == best_t && index < best_index)
+}
+
+/// The exclusive limit that lets a hit tie with one at `t` (the smallest
+/// `f64` above a finite, non-negative `t`), so [`wins`] can see the tie.
+#[inline(always)]
+pub fn probe_past(t: f64) -> f64 {
+    if t.is_finite() {
+        f64::from_bits(t.to_bits() + 1)
+    } else {
+        t
+    }
+}
+
 /// A ray prepared once for every query it takes part in: the octree walk's
 /// reciprocal direction and sign bits, and the watertight triangle test's
 /// axis permutation and shear constants (Woop, Benthin & Wald 2013).
@@ -31,14 +77,9 @@ impl PreparedRay {
     pub fn new(ray: Ray) -> Self {
         let d = ray.dir;
         let permutation = Self::permutation_of(d);
-        let shear = match permutation {
-            0 => DVec3::new(d.y / d.x, d.z / d.x, 1.0 / d.x),
-            1 => DVec3::new(d.z / d.x, d.y / d.x, 1.0 / d.x),
-            2 => DVec3::new(d.z / d.y, d.x / d.y, 1.0 / d.y),
-            3 => DVec3::new(d.x / d.y, d.z / d.y, 1.0 / d.y),
-            4 => DVec3::new(d.x / d.z, d.y / d.z, 1.0 / d.z),
-            _ => DVec3::new(d.y / d.z, d.x / d.z, 1.0 / d.z),
-        };
+        let shear = along_axes!(permutation, |KX, KY, KZ| {
+            DVec3::new(d[KX] / d[KZ], d[KY] / d[KZ], 1.0 / d[KZ])
+        });
         let d = d.to_array();
         let mut inv_dir = [0.0; 3];
         let (mut negative, mut parallel) = (0, 0);
@@ -81,14 +122,7 @@ impl PreparedRay {
     /// negative.
     #[cfg(test)]
     pub(super) fn axes_of(permutation: u8) -> (usize, usize, usize) {
-        match permutation {
-            0 => (1, 2, 0),
-            1 => (2, 1, 0),
-            2 => (2, 0, 1),
-            3 => (0, 2, 1),
-            4 => (0, 1, 2),
-            _ => (1, 0, 2),
-        }
+        along_axes!(permutation, |KX, KY, KZ| (KX, KY, KZ))
     }
 }
 

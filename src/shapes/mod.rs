@@ -11,7 +11,7 @@ mod triangle;
 
 pub use cone::Cone;
 pub(crate) use hit::unit_or_none;
-pub use hit::{Crossings, PreparedRay, ShapeHit, Surface};
+pub use hit::{Crossings, PreparedRay, ShapeHit, Surface, probe_past, wins};
 pub use packet::{LaneHits, PacketHits, RayPacket};
 pub use plane::Plane;
 pub use quadric::Quadric;

@@ -8,7 +8,7 @@
 // Lane loops index several arrays by the same lane number.
 #![allow(clippy::needless_range_loop)]
 
-use super::hit::PreparedRay;
+use super::hit::{PreparedRay, along_axes, probe_past, wins};
 use super::sphere::Sphere;
 use super::triangle::Triangle;
 use crate::math::{DVec3, Ray};
@@ -67,14 +67,9 @@ impl<const N: usize> RayPacket<N> {
         if (1..rays.len()).any(|i| PreparedRay::permutation_of(rays[i].dir) != permutation) {
             return None;
         }
-        let shear = match permutation {
-            0 => shear_along::<1, 2, 0, N>(&dir, &inv_dir),
-            1 => shear_along::<2, 1, 0, N>(&dir, &inv_dir),
-            2 => shear_along::<2, 0, 1, N>(&dir, &inv_dir),
-            3 => shear_along::<0, 2, 1, N>(&dir, &inv_dir),
-            4 => shear_along::<0, 1, 2, N>(&dir, &inv_dir),
-            _ => shear_along::<1, 0, 2, N>(&dir, &inv_dir),
-        };
+        let shear = along_axes!(permutation, |KX, KY, KZ| shear_along::<KX, KY, KZ, N>(
+            &dir, &inv_dir
+        ));
         Some(Self {
             live: all >> (N - rays.len()),
             origin,
@@ -159,18 +154,12 @@ impl<const N: usize> PacketHits<N> {
         while lanes != 0 {
             let i = lanes.trailing_zeros() as usize;
             lanes &= lanes - 1;
-            // The hit beat the probe, so t <= the best t: it wins unless it
-            // ties with a lower index.
-            if t[i] < self.t[i] || index < self.shape[i] {
+            if wins(t[i], index, self.t[i], self.shape[i]) {
                 self.t[i] = t[i];
                 self.b1[i] = b1[i];
                 self.b2[i] = b2[i];
                 self.shape[i] = index;
-                self.probe[i] = if t[i].is_finite() {
-                    f64::from_bits(t[i].to_bits() + 1)
-                } else {
-                    t[i]
-                };
+                self.probe[i] = probe_past(t[i]);
             }
         }
     }
@@ -194,14 +183,8 @@ impl Triangle {
         p: &RayPacket<N>,
         t_max: &F64s<N>,
     ) -> LaneHits<N> {
-        match p.permutation {
-            0 => self.lanes_along::<1, 2, 0, N>(p, t_max),
-            1 => self.lanes_along::<2, 1, 0, N>(p, t_max),
-            2 => self.lanes_along::<2, 0, 1, N>(p, t_max),
-            3 => self.lanes_along::<0, 2, 1, N>(p, t_max),
-            4 => self.lanes_along::<0, 1, 2, N>(p, t_max),
-            _ => self.lanes_along::<1, 0, 2, N>(p, t_max),
-        }
+        along_axes!(p.permutation, |KX, KY, KZ| self
+            .lanes_along::<KX, KY, KZ, N>(p, t_max))
     }
 
     /// The watertight test (Woop, Benthin & Wald 2013) in lanes, with the

@@ -3,7 +3,7 @@
 //! mesh; interpolated vertex normals for smooth meshes; and the exact
 //! triangle/box overlap (separating axes) the octree classifies with.
 
-use super::hit::{PreparedRay, ShapeHit, Surface, unit_or_none};
+use super::hit::{PreparedRay, ShapeHit, Surface, along_axes, unit_or_none};
 use crate::math::{Aabb, DVec3};
 
 /// Marker for "no vertex normals": the triangle is flat shaded.
@@ -51,14 +51,8 @@ impl Triangle {
     pub fn intersect(&self, r: &PreparedRay, t_max: f64) -> Option<ShapeHit> {
         // The axes are a run-time choice per ray: dispatching once to code
         // with constant axes avoids indexing vectors by a variable.
-        match r.permutation {
-            0 => self.intersect_along::<1, 2, 0>(r, t_max),
-            1 => self.intersect_along::<2, 1, 0>(r, t_max),
-            2 => self.intersect_along::<2, 0, 1>(r, t_max),
-            3 => self.intersect_along::<0, 2, 1>(r, t_max),
-            4 => self.intersect_along::<0, 1, 2>(r, t_max),
-            _ => self.intersect_along::<1, 0, 2>(r, t_max),
-        }
+        along_axes!(r.permutation, |KX, KY, KZ| self
+            .intersect_along::<KX, KY, KZ>(r, t_max))
     }
 
     /// [`Triangle::intersect`] for a ray whose permutation is `(KX, KY, KZ)`.

@@ -31,6 +31,7 @@ mod packet_walk;
 mod params;
 mod predict;
 mod tree;
+mod visit;
 mod walk;
 
 pub use packet_walk::PacketStack;

@@ -15,57 +15,24 @@
 
 use super::node::{LEVEL_MASK, Node, child_corner};
 use super::tree::Octree;
+use super::visit::{CellEntry, CellStack, Mailbox, Visitor};
 use crate::accel::primitives::{Primitives, ShadowCrossings, test_occlusion};
 use crate::limits::MAX_OCTREE_DEPTH;
 use crate::shapes::{PacketHits, RayPacket};
 use crate::simd::{F64s, lanes, mask, max, min, per_axis};
 use crate::stats::Counter;
 
-/// A cell waiting on a packet's stack: its corner, node and level, and
-/// each lane's parameters at its entry and exit (empty where the lane's
-/// ray misses it; the exit no later than the lane's limit when the cell
-/// was pushed).
-#[derive(Clone, Copy, Debug)]
-struct PacketEntry<const N: usize> {
-    min: [f64; 3],
-    t0: F64s<N>,
-    t1: F64s<N>,
-    node: u32,
-    level: u32,
-}
-
 /// Room on a packet's stack: each level may leave seven siblings waiting,
-/// plus the cell being entered.
-pub const PACKET_STACK_CAPACITY: usize = 7 * MAX_OCTREE_DEPTH as usize + 8;
+/// plus the cell being entered (rounded up to a power of two).
+const PACKET_STACK_CAPACITY: usize = (7 * MAX_OCTREE_DEPTH as usize + 8).next_power_of_two();
 
-/// The cells a packet has still to visit: scratch space the caller owns
-/// (one per tile).
-pub struct PacketStack<const N: usize> {
-    entries: Vec<PacketEntry<N>>,
-}
-
-impl<const N: usize> Default for PacketStack<N> {
-    fn default() -> Self {
-        let empty = PacketEntry {
-            min: [0.0; 3],
-            t0: [0.0; N],
-            t1: [0.0; N],
-            node: 0,
-            level: 0,
-        };
-        Self {
-            entries: vec![empty; PACKET_STACK_CAPACITY],
-        }
-    }
-}
+/// A packet's walk stack.
+pub type PacketStack<const N: usize> = CellStack<F64s<N>, PACKET_STACK_CAPACITY>;
 
 /// What a packet's walk does at its leaves.
-trait PacketVisitor<const N: usize> {
+trait PacketVisitor<const N: usize>: Visitor<Limit = F64s<N>> {
     /// Tests the shape `index` in `lanes`.
     fn test(&mut self, index: u32, lanes: u32);
-    /// Each lane's limit: cells starting beyond it cannot change its answer.
-    fn limit(&self) -> F64s<N>;
-    fn counter(&mut self) -> &mut impl Counter;
 }
 
 struct Closest<'a, C, const N: usize> {
@@ -75,19 +42,24 @@ struct Closest<'a, C, const N: usize> {
     counter: &'a mut C,
 }
 
-impl<C: Counter, const N: usize> PacketVisitor<N> for Closest<'_, C, N> {
-    #[inline(always)]
-    fn test(&mut self, index: u32, lanes: u32) {
-        self.prims
-            .closest_lanes(index, self.packet, lanes, &mut self.best, self.counter);
-    }
+impl<C: Counter, const N: usize> Visitor for Closest<'_, C, N> {
+    type Limit = F64s<N>;
+    type C = C;
     #[inline(always)]
     fn limit(&self) -> F64s<N> {
         self.best.t
     }
     #[inline(always)]
-    fn counter(&mut self) -> &mut impl Counter {
+    fn counter(&mut self) -> &mut C {
         self.counter
+    }
+}
+
+impl<C: Counter, const N: usize> PacketVisitor<N> for Closest<'_, C, N> {
+    #[inline(always)]
+    fn test(&mut self, index: u32, lanes: u32) {
+        self.prims
+            .closest_lanes(index, self.packet, lanes, &mut self.best, self.counter);
     }
 }
 
@@ -100,6 +72,23 @@ struct Shadowed<'a, C, const N: usize> {
     /// Each lane's crossings of transparent shapes.
     found: &'a mut [ShadowCrossings; N],
     counter: &'a mut C,
+}
+
+impl<C: Counter, const N: usize> Visitor for Shadowed<'_, C, N> {
+    type Limit = F64s<N>;
+    type C = C;
+    #[inline(always)]
+    fn limit(&self) -> F64s<N> {
+        lanes!(N, |i| if self.blocked >> i & 1 == 1 {
+            f64::NEG_INFINITY
+        } else {
+            self.t_max[i]
+        })
+    }
+    #[inline(always)]
+    fn counter(&mut self) -> &mut C {
+        self.counter
+    }
 }
 
 impl<C: Counter, const N: usize> PacketVisitor<N> for Shadowed<'_, C, N> {
@@ -129,39 +118,6 @@ impl<C: Counter, const N: usize> PacketVisitor<N> for Shadowed<'_, C, N> {
             self.blocked |=
                 self.prims
                     .blocked_lanes(index, self.packet, &self.t_max, lanes, self.counter);
-        }
-    }
-    #[inline(always)]
-    fn limit(&self) -> F64s<N> {
-        lanes!(N, |i| if self.blocked >> i & 1 == 1 {
-            f64::NEG_INFINITY
-        } else {
-            self.t_max[i]
-        })
-    }
-    #[inline(always)]
-    fn counter(&mut self) -> &mut impl Counter {
-        self.counter
-    }
-}
-
-/// Remembers, for the last shapes tested, the lanes they were tested in
-/// (direct-mapped, 16 entries), so a shape referenced from several leaves
-/// is tested once per lane, as the single-ray mailbox does.
-struct LaneMailbox([(u32, u32); 16]);
-
-impl LaneMailbox {
-    /// The lanes of `lanes` in which `index` is not yet tested; records them.
-    #[inline(always)]
-    fn untested(&mut self, index: u32, lanes: u32) -> u32 {
-        let slot = &mut self.0[(index & 15) as usize];
-        if slot.0 == index {
-            let fresh = lanes & !slot.1;
-            slot.1 |= fresh;
-            fresh
-        } else {
-            *slot = (index, lanes);
-            lanes
         }
     }
 }
@@ -251,8 +207,8 @@ impl Octree {
         if mask(t0, t1, |a, b| a <= b) & p.live == 0 {
             return;
         }
-        let entries = &mut stack.entries[..];
-        entries[0] = PacketEntry {
+        let entries = stack.entries();
+        entries[0] = CellEntry {
             min: lo,
             t0,
             t1,
@@ -260,7 +216,7 @@ impl Octree {
             level: 0,
         };
         let mut top = 1;
-        let mut mailbox = LaneMailbox([(u32::MAX, 0); 16]);
+        let mut mailbox = Mailbox::new();
         while top > 0 {
             top -= 1;
             let e = entries[top];
@@ -343,7 +299,7 @@ impl Octree {
 
 /// An interior cell being split for a packet.
 struct Cell<'a, const N: usize> {
-    e: &'a PacketEntry<N>,
+    e: &'a CellEntry<F64s<N>>,
     /// The mid-planes, where the upper children start.
     mid: [f64; 3],
     /// Each octant's entry and exit per lane, by its far bits.
@@ -361,7 +317,7 @@ impl<const N: usize> Cell<'_, N> {
     #[inline(always)]
     fn push<const FAR: u32, V: PacketVisitor<N>>(
         &self,
-        entries: &mut [PacketEntry<N>],
+        entries: &mut [CellEntry<F64s<N>>; PACKET_STACK_CAPACITY],
         top: &mut usize,
         visitor: &mut V,
     ) {
@@ -379,7 +335,7 @@ impl<const N: usize> Cell<'_, N> {
             return;
         }
         let e = self.e;
-        entries[*top] = PacketEntry {
+        entries[*top & (PACKET_STACK_CAPACITY - 1)] = CellEntry {
             min: child_corner(e.min, self.mid, c),
             t0: c0,
             t1: c1,

@@ -4,6 +4,7 @@
 
 use super::node::{LEVEL_MASK, child_corner};
 use super::tree::Octree;
+use super::visit::{CellEntry, CellStack, Mailbox, Visitor};
 use crate::accel::primitives::{
     ClosestHit, Primitives, ShadowCrossings, test_closest, test_occlusion,
 };
@@ -33,7 +34,7 @@ impl Octree {
         for &i in &self.unbounded {
             test_closest(prims, i, ray, &mut visitor.best, t_max, visitor.counter);
         }
-        let limit = visitor.best.map_or(t_max, |b| b.hit.t);
+        let limit = visitor.limit();
         self.walk(ray, limit, stack, &mut visitor);
         visitor.best
     }
@@ -116,8 +117,8 @@ impl Octree {
         };
         let o = ray.ray.origin.to_array();
         let inv = ray.inv_dir;
-        let entries = &mut stack.entries;
-        entries[0] = Entry {
+        let entries = stack.entries();
+        entries[0] = CellEntry {
             min: self.bounds.min.to_array(),
             t0,
             t1,
@@ -130,7 +131,7 @@ impl Octree {
             let e = entries[top];
             // The stack holds cells in order along the ray, nearest on top:
             // once one starts past the limit, all the others do.
-            if e.t0 > visitor.t_limit() {
+            if e.t0 > visitor.limit() {
                 visitor.counter().walk_end(V::BEYOND_LIMIT);
                 return;
             }
@@ -216,7 +217,7 @@ impl Octree {
             // Farthest first, so the nearest is popped next. Empty octants
             // are counted as entered leaves (Havran's measures) but cost
             // nothing else.
-            let limit = visitor.t_limit();
+            let limit = visitor.limit();
             let mask = node.mask();
             for i in (0..=n).rev() {
                 let c = children[i];
@@ -236,7 +237,7 @@ impl Octree {
                     }
                     continue;
                 }
-                entries[top & (STACK_CAPACITY - 1)] = Entry {
+                entries[top & (STACK_CAPACITY - 1)] = CellEntry {
                     min,
                     t0: times[i],
                     t1: times[i + 1],
@@ -250,67 +251,20 @@ impl Octree {
     }
 }
 
-/// A cell waiting on the traversal stack: its lowest corner, the ray's
-/// parameters at its entry and exit, its node and its level (which gives
-/// its side).
-#[derive(Clone, Copy, Debug, Default)]
-struct Entry {
-    min: [f64; 3],
-    t0: f64,
-    t1: f64,
-    node: u32,
-    level: u32,
-}
-
 /// Room on the traversal stack: each level leaves at most three siblings
 /// waiting, plus the cell being entered (a power of two, so indices are
 /// masked instead of bounds-checked).
 const STACK_CAPACITY: usize = (3 * MAX_OCTREE_DEPTH as usize + 4).next_power_of_two();
 
-/// The cells a walk has still to visit: scratch space the caller owns
-/// (one per tile of the image), so no ray sets it up.
-pub struct WalkStack {
-    entries: [Entry; STACK_CAPACITY],
-}
+/// A single ray's walk stack.
+pub type WalkStack = CellStack<f64, STACK_CAPACITY>;
 
-impl Default for WalkStack {
-    fn default() -> Self {
-        Self {
-            entries: [Entry::default(); STACK_CAPACITY],
-        }
-    }
-}
-
-/// Remembers the last shapes tested for this ray, so a shape referenced
-/// from several leaves is usually tested once (direct-mapped, 16 entries).
-struct Mailbox([u32; 16]);
-
-impl Mailbox {
-    fn new() -> Self {
-        Self([u32::MAX; 16])
-    }
-
-    /// `true` if `index` was tested already; records it otherwise.
-    #[inline(always)]
-    fn seen(&mut self, index: u32) -> bool {
-        let slot = &mut self.0[(index & 15) as usize];
-        if *slot == index {
-            return true;
-        }
-        *slot = index;
-        false
-    }
-}
-
-trait LeafVisitor {
-    type C: Counter;
-    fn counter(&mut self) -> &mut Self::C;
+/// What a single ray's walk does at its leaves.
+trait LeafVisitor: Visitor<Limit = f64> {
     /// Tests the shapes of a leaf the ray leaves at `t_exit`; `true` to stop.
     fn visit_leaf(&mut self, refs: &[u32], t_exit: f64) -> bool;
-    /// Cells starting beyond this parameter cannot change the answer.
-    fn t_limit(&self) -> f64;
     /// Why the walk ends when `visit_leaf` says stop, and when the next
-    /// cell starts beyond `t_limit`.
+    /// cell starts beyond the limit.
     const STOPPED: WalkEnd;
     const BEYOND_LIMIT: WalkEnd;
 }
@@ -324,13 +278,21 @@ struct ClosestVisitor<'a, C> {
     counter: &'a mut C,
 }
 
-impl<C: Counter> LeafVisitor for ClosestVisitor<'_, C> {
+impl<C: Counter> Visitor for ClosestVisitor<'_, C> {
+    type Limit = f64;
     type C = C;
-    const STOPPED: WalkEnd = WalkEnd::HitInCell;
-    const BEYOND_LIMIT: WalkEnd = WalkEnd::CellsBeyondHit;
     fn counter(&mut self) -> &mut C {
         self.counter
     }
+
+    fn limit(&self) -> f64 {
+        self.best.map_or(self.t_max, |b| b.hit.t)
+    }
+}
+
+impl<C: Counter> LeafVisitor for ClosestVisitor<'_, C> {
+    const STOPPED: WalkEnd = WalkEnd::HitInCell;
+    const BEYOND_LIMIT: WalkEnd = WalkEnd::CellsBeyondHit;
 
     #[inline(always)]
     fn visit_leaf(&mut self, refs: &[u32], t_exit: f64) -> bool {
@@ -350,10 +312,6 @@ impl<C: Counter> LeafVisitor for ClosestVisitor<'_, C> {
         // only a hit strictly inside this cell ends the walk.
         self.best.is_some_and(|b| b.hit.t < t_exit)
     }
-
-    fn t_limit(&self) -> f64 {
-        self.best.map_or(self.t_max, |b| b.hit.t)
-    }
 }
 
 struct OcclusionVisitor<'a, C> {
@@ -365,13 +323,21 @@ struct OcclusionVisitor<'a, C> {
     counter: &'a mut C,
 }
 
-impl<C: Counter> LeafVisitor for OcclusionVisitor<'_, C> {
+impl<C: Counter> Visitor for OcclusionVisitor<'_, C> {
+    type Limit = f64;
     type C = C;
-    const STOPPED: WalkEnd = WalkEnd::Blocked;
-    const BEYOND_LIMIT: WalkEnd = WalkEnd::CellsBeyondLight;
     fn counter(&mut self) -> &mut C {
         self.counter
     }
+
+    fn limit(&self) -> f64 {
+        self.t_max
+    }
+}
+
+impl<C: Counter> LeafVisitor for OcclusionVisitor<'_, C> {
+    const STOPPED: WalkEnd = WalkEnd::Blocked;
+    const BEYOND_LIMIT: WalkEnd = WalkEnd::CellsBeyondLight;
 
     #[inline(always)]
     fn visit_leaf(&mut self, refs: &[u32], _t_exit: f64) -> bool {
@@ -390,9 +356,5 @@ impl<C: Counter> LeafVisitor for OcclusionVisitor<'_, C> {
             }
         }
         false
-    }
-
-    fn t_limit(&self) -> f64 {
-        self.t_max
     }
 }
