@@ -535,21 +535,6 @@ fn flags_without_effect_are_refused() {
     }
 }
 
-/// A build without the viewer says so for `glint view`, rather than
-/// calling it an unknown subcommand (after CI's no-GUI tests, the binary
-/// in target/release is such a build).
-#[cfg(not(feature = "gui"))]
-#[test]
-fn a_build_without_the_viewer_says_so() {
-    let o = glint(&["view", "scenes/default.toml", "--screenshot", "x.png"]);
-    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
-    assert!(
-        stderr(&o).contains("built without the viewer"),
-        "{}",
-        stderr(&o)
-    );
-}
-
 /// Multi-scene commands check every scene file before timing any (a
 /// missing last one failed after the others were measured, with no
 /// results), and `study` keeps two scenes of one name apart.

@@ -93,19 +93,9 @@ fn main() -> std::process::ExitCode {
         say!("note: {}", simd.reason);
     }
     let result = match cli.command {
-        Some(Command::Render(args)) => render_cmd::run(&args),
-        Some(Command::Bench(args)) => bench::run(&args),
-        Some(Command::Study(args)) => study::run(&args),
-        Some(Command::Info(args)) => info::run(&args),
-        #[cfg(feature = "gui")]
-        Some(Command::View(args)) => view::run(&args),
+        Some(command) => run(command),
         #[cfg(feature = "gui")]
         None => view::run(&view::ViewArgs::default()),
-        #[cfg(not(feature = "gui"))]
-        Some(Command::View { .. }) => Err(anyhow::anyhow!(
-            "this glint was built without the viewer (cargo feature `gui`, on by default): \
-             build it with `cargo build --release`, or render headless with `glint render`"
-        )),
         #[cfg(not(feature = "gui"))]
         None => {
             use clap::CommandFactory;
@@ -120,6 +110,23 @@ fn main() -> std::process::ExitCode {
             say!("error: {e:#}");
             std::process::ExitCode::FAILURE
         }
+    }
+}
+
+/// Runs one subcommand.
+fn run(command: Command) -> anyhow::Result<()> {
+    match command {
+        Command::Render(args) => render_cmd::run(&args),
+        Command::Bench(args) => bench::run(&args),
+        Command::Study(args) => study::run(&args),
+        Command::Info(args) => info::run(&args),
+        #[cfg(feature = "gui")]
+        Command::View(args) => view::run(&args),
+        #[cfg(not(feature = "gui"))]
+        Command::View { .. } => Err(anyhow::anyhow!(
+            "this glint was built without the viewer (cargo feature `gui`, on by default): \
+             build it with `cargo build --release`, or render headless with `glint render`"
+        )),
     }
 }
 
@@ -161,6 +168,30 @@ mod tests {
     #[test]
     fn the_command_line_definition_is_consistent() {
         Cli::command().debug_assert();
+    }
+
+    /// A build without the viewer says so for `glint view` (and for a
+    /// scene given alone), rather than calling it an unknown subcommand.
+    /// CI runs the no-GUI build's tests of this binary only: the library's
+    /// code is the same in both builds, and its tests run in the GUI build.
+    #[cfg(not(feature = "gui"))]
+    #[test]
+    fn a_build_without_the_viewer_says_so() {
+        for args in [
+            &[
+                "glint",
+                "view",
+                "scenes/default.toml",
+                "--screenshot",
+                "x.png",
+            ][..],
+            &["glint", "scene.toml"],
+        ] {
+            let args = with_default_command(args.iter().map(Into::into).collect());
+            let cli = Cli::try_parse_from(args).unwrap();
+            let e = run(cli.command.unwrap()).unwrap_err().to_string();
+            assert!(e.contains("built without the viewer"), "{e}");
+        }
     }
 
     #[test]
