@@ -34,6 +34,15 @@ pub(super) struct ShadingPoint {
     color: Color,
 }
 
+/// A secondary ray of a hit: its kind, the ray and the weight of what it
+/// sees in the hit's colour.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Secondary {
+    pub kind: RayKind,
+    pub ray: Ray,
+    pub weight: f64,
+}
+
 impl Renderer<'_> {
     /// Colour seen along `ray`, which is at recursion `depth` (eye ray = 1).
     pub(super) fn trace<C: Counter, R: RayRecorder>(
@@ -305,9 +314,29 @@ impl Renderer<'_> {
         rays: &mut RayCounts,
         rec: &mut R,
     ) {
+        for secondary in self.secondary_of(ray, at, rays).into_iter().flatten() {
+            let Secondary { kind, ray, weight } = secondary;
+            let mut child = rec.child(kind, &ray, depth + 1, weight);
+            let seen = self.trace(&ray, depth + 1, query, rays, &mut child);
+            rec.attach(child, seen);
+            *color += weight * seen;
+        }
+    }
+
+    /// The refracted and the mirror ray from `at`, in the order their
+    /// colours are added (each where the material spawns it), counted in
+    /// `rays`.
+    #[inline(always)]
+    pub(super) fn secondary_of(
+        &self,
+        ray: &Ray,
+        at: &ShadingPoint,
+        rays: &mut RayCounts,
+    ) -> [Option<Secondary>; 2] {
         let material = &self.materials[at.material as usize];
         let (p, n, facing) = (at.point, at.normal, at.facing);
         let mut reflect_weight = material.reflectivity;
+        let mut refraction = None;
         if material.transparency > 0.0 {
             let eta = if at.entering {
                 1.0 / material.ior
@@ -318,12 +347,11 @@ impl Renderer<'_> {
                 Some(dir) => {
                     rays.refraction += 1;
                     let origin = offset_ray_origin(p, -facing, self.floor_scale);
-                    let child_ray = Ray::new(origin, dir);
-                    let weight = material.transparency;
-                    let mut child = rec.child(RayKind::Refraction, &child_ray, depth + 1, weight);
-                    let seen = self.trace(&child_ray, depth + 1, query, rays, &mut child);
-                    rec.attach(child, seen);
-                    *color += weight * seen;
+                    refraction = Some(Secondary {
+                        kind: RayKind::Refraction,
+                        ray: Ray::new(origin, dir),
+                        weight: material.transparency,
+                    });
                 }
                 // Total internal reflection: the transmitted share is reflected.
                 None => {
@@ -338,7 +366,7 @@ impl Renderer<'_> {
             Protocol::Glint => reflect_weight > 0.0,
             Protocol::Spd => material.reflectivity > 0.0 || material.transparency > 0.0,
         };
-        if spawn_reflection {
+        let reflection = spawn_reflection.then(|| {
             rays.reflection += 1;
             let mut dir = reflect(ray.dir, n);
             // An interpolated normal can send the mirror ray below the
@@ -347,11 +375,12 @@ impl Renderer<'_> {
                 dir = reflect(ray.dir, facing);
             }
             let origin = offset_ray_origin(p, facing, self.floor_scale);
-            let child_ray = Ray::new(origin, dir.normalize());
-            let mut child = rec.child(RayKind::Reflection, &child_ray, depth + 1, reflect_weight);
-            let seen = self.trace(&child_ray, depth + 1, query, rays, &mut child);
-            rec.attach(child, seen);
-            *color += reflect_weight * seen;
-        }
+            Secondary {
+                kind: RayKind::Reflection,
+                ray: Ray::new(origin, dir.normalize()),
+                weight: reflect_weight,
+            }
+        });
+        [refraction, reflection]
     }
 }
