@@ -283,6 +283,7 @@ fn report(
         sent: drag.counts_at_release.sent - drag.counts_before.sent,
         started: drag.counts_at_release.started - drag.counts_before.started,
         completed: drag.counts_at_release.completed - drag.counts_before.completed,
+        dropped: drag.counts_at_release.dropped - drag.counts_before.dropped,
     };
     // Previews still in flight at the release end in the final passes'
     // cancellation: count them from the whole run.

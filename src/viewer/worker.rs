@@ -87,6 +87,7 @@ struct Shared {
     previews_sent: AtomicU64,
     previews_started: AtomicU64,
     previews_completed: AtomicU64,
+    previews_dropped: AtomicU64,
     /// The newest full job's generation ([`Worker::full_generation`]).
     full_generation: AtomicU64,
     /// The octree switch of the last full job rendered: a job that flips
@@ -113,6 +114,10 @@ pub struct PreviewCounts {
     pub started: u64,
     /// Previews that finished and went into the display buffer.
     pub completed: u64,
+    /// Previews sent that a newer job replaced before they started: a full
+    /// render (the drag ended, or a frame near the press was not yet a
+    /// drag) or a cancel. A newer preview never replaces one: it waits.
+    pub dropped: u64,
 }
 
 /// Tiles arrive far faster than a screen refreshes; asking for a repaint
@@ -166,6 +171,7 @@ impl Worker {
             previews_sent: AtomicU64::new(0),
             previews_started: AtomicU64::new(0),
             previews_completed: AtomicU64::new(0),
+            previews_dropped: AtomicU64::new(0),
             full_generation: AtomicU64::new(0),
             last_octree_switch: Mutex::new(None),
         });
@@ -239,6 +245,7 @@ impl Worker {
             sent: self.shared.previews_sent.load(Ordering::SeqCst),
             started: self.shared.previews_started.load(Ordering::SeqCst),
             completed: self.shared.previews_completed.load(Ordering::SeqCst),
+            dropped: self.shared.previews_dropped.load(Ordering::SeqCst),
         }
     }
 
@@ -360,12 +367,27 @@ fn run(shared: Arc<Shared>, rx: Receiver<(u64, Job)>, threads: usize) {
     };
     while let Ok(mut next) = rx.recv() {
         // Only the newest job matters.
+        let dropped = |job: &Job| {
+            if job.preview.is_some() {
+                shared.previews_dropped.fetch_add(1, Ordering::SeqCst);
+            }
+        };
         while let Ok(newer) = rx.try_recv() {
+            dropped(&next.1);
             next = newer;
         }
         let (mut generation, mut job) = next;
-        while shared.generation.load(Ordering::SeqCst) == generation {
+        loop {
+            if shared.generation.load(Ordering::SeqCst) != generation {
+                dropped(&job);
+                break;
+            }
+            let started = shared.previews_started.load(Ordering::SeqCst);
             pool.install(|| render_job(&shared, generation, &job));
+            if job.preview.is_some() && shared.previews_started.load(Ordering::SeqCst) == started {
+                // Cancelled before it began (or shown from the cache).
+                dropped(&job);
+            }
             if job.preview.is_none() {
                 break;
             }

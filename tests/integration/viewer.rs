@@ -216,14 +216,19 @@ fn a_drag_cancels_no_preview_and_ends_on_the_newest_camera() {
         started,
         "every preview started was completed"
     );
-    // Every preview given a generation started: none was cancelled
-    // unstarted by a newer one. (Counting generations instead also counted
-    // a full job when, under load, a frame near the press was not yet a
-    // drag: that failed once in a full run.)
+    // Every preview given a generation started, or was replaced before it
+    // started by a full render: under load a frame near the press may not
+    // yet be a drag (that failed the test about once in eight runs beside
+    // a busy machine). A newer preview never replaces one.
+    let dropped = counts.dropped - before.dropped;
     assert_eq!(
         counts.sent - before.sent,
-        started,
-        "no preview was sent that never started"
+        started + dropped,
+        "no preview was sent that never started unless dropped: {counts:?}"
+    );
+    assert!(
+        dropped == 0 || h.state().worker().full_generation() > generation_before,
+        "a preview was dropped with no full render to replace it: {counts:?}"
     );
     assert!(h.state().worker().generation() - generation_before >= started);
     assert!(
