@@ -125,6 +125,7 @@ impl<C: Counter, const N: usize> pulp::WithSimd for OcclusionWalk<'_, '_, '_, C,
 struct SecondaryWork<'w, 'r, 'a, 'q, C, R, const N: usize> {
     renderer: &'r Renderer<'a>,
     rays: &'w [Ray],
+    depth: u32,
     points: &'w [Option<ShadingPoint>; N],
     colors: &'w mut [Color; N],
     query: &'w mut Query<'q, C>,
@@ -143,6 +144,7 @@ impl<C: Counter, R: RayRecorder, const N: usize> pulp::WithSimd
         self.renderer.secondary_lanes(
             simd,
             self.rays,
+            self.depth,
             self.points,
             self.colors,
             self.query,
@@ -402,6 +404,7 @@ impl Renderer<'_> {
             simd.vectorize(SecondaryWork {
                 renderer: self,
                 rays,
+                depth: 1,
                 points: &points,
                 colors: &mut colors,
                 query,
@@ -492,20 +495,22 @@ impl Renderer<'_> {
         }
     }
 
-    /// The secondary rays of the eye hits `points` (lane k's seen along
-    /// `rays[k]`), added to `colors` as [`Renderer::secondary_rays`] adds
-    /// them, byte for byte: the refraction rays of all lanes, then their
-    /// reflection rays, go as a packet where they are coherent (a mirror's
-    /// or a glass sphere's neighbouring pixels) and the shadow rays of
-    /// their hits towards each light too; deeper rays go one by one. Each
-    /// ray's own arithmetic, and the order in which a hit adds what its
-    /// rays see, are the single-ray path's.
+    /// The secondary rays of the hits `points` of rays at `depth` (lane
+    /// k's seen along `rays[k]`), added to `colors` as
+    /// [`Renderer::secondary_rays`] adds them, byte for byte: the
+    /// refraction rays of all lanes, then their reflection rays, go as a
+    /// packet where they are coherent (a mirror's or a glass sphere's
+    /// neighbouring pixels) and the shadow rays of their hits towards each
+    /// light too, and so on down to the scene's depth. Each ray's own
+    /// arithmetic, and the order in which a hit adds what its rays see, are
+    /// the single-ray path's.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn secondary_lanes<S: pulp::Simd, C: Counter, R: RayRecorder, const N: usize>(
         &self,
         simd: S,
         rays: &[Ray],
+        depth: u32,
         points: &[Option<ShadingPoint>; N],
         colors: &mut [Color; N],
         query: &mut Query<C>,
@@ -544,7 +549,7 @@ impl Renderer<'_> {
                     (RayKind::Reflection, Ray::new(DVec3::ZERO, DVec3::X), 0.0),
                     |s| (s.kind, s.ray, s.weight),
                 );
-                recs[k].child(s.0, &s.1, 2, s.2)
+                recs[k].child(s.0, &s.1, depth + 1, s.2)
             });
             let child_rays = &child_rays[..m];
             let hits = self.closest_lanes::<S, C, N>(simd, child_rays, query, stack);
@@ -561,23 +566,29 @@ impl Renderer<'_> {
                 ray_counts,
                 &mut crecs,
             );
-            for (j, crec) in crecs.into_iter().enumerate().take(m) {
-                let mut crec = crec;
-                if let Some(at) = &child_points[j] {
-                    crec.local(child_colors[j]);
-                    if 2 < self.settings.max_depth {
-                        self.secondary_rays(
-                            &child_rays[j],
-                            at,
-                            2,
-                            &mut child_colors[j],
-                            query,
-                            ray_counts,
-                            &mut crec,
-                        );
+            if depth + 1 < self.settings.max_depth {
+                // The next level the same way, in a call of its own (the
+                // depth is at most 64: the stack holds 64 such frames).
+                simd.vectorize(SecondaryWork {
+                    renderer: self,
+                    rays: child_rays,
+                    depth: depth + 1,
+                    points: &child_points,
+                    colors: &mut child_colors,
+                    query: &mut *query,
+                    stack: &mut *stack,
+                    ray_counts: &mut *ray_counts,
+                    recs: &mut crecs,
+                });
+            } else {
+                for j in 0..m {
+                    if child_points[j].is_some() {
+                        crecs[j].local(child_colors[j]);
+                        crecs[j].finish(child_colors[j]);
                     }
-                    crec.finish(child_colors[j]);
                 }
+            }
+            for (j, crec) in crecs.into_iter().enumerate().take(m) {
                 seen[lanes[j]][kind] = child_colors[j];
                 child_recs[lanes[j]][kind] = Some(crec);
             }
