@@ -9,6 +9,10 @@ use walk_record::{CellVisit, QueryRecord, WalkEnd};
 
 /// Receives one call per unit of work done for a ray.
 pub trait Counter {
+    /// Whether anything is counted. Havran's measures are the exact
+    /// octree walk's, so only a counter that counts nothing lets a query
+    /// take the faster wide walk (the same answers, other cells).
+    const COUNTS: bool = true;
     #[inline(always)]
     fn intersection_test(&mut self) {}
     #[inline(always)]
@@ -43,7 +47,9 @@ pub trait Counter {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct NoCounts;
 
-impl Counter for NoCounts {}
+impl Counter for NoCounts {
+    const COUNTS: bool = false;
+}
 
 /// Havran's machine-independent measures, summed over rays: intersection
 /// tests (N_IT), traversal steps, i.e. octree nodes entered (N_TS), and

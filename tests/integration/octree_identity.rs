@@ -9,7 +9,7 @@ use glint::accel::{
 };
 use glint::math::{DVec3, Ray};
 use glint::shapes::{PreparedRay, Shape, Sphere, Triangle};
-use glint::stats::NoCounts;
+use glint::stats::{NoCounts, WorkCounts};
 use proptest::prelude::*;
 
 #[test]
@@ -44,16 +44,22 @@ fn octree_on_and_off_give_identical_bytes_for_every_scene() {
 /// Shapes for the property tests: small random triangles and spheres in
 /// the box [-4, 4]^3, some of them on the octree's split planes.
 fn shapes_strategy() -> impl Strategy<Value = Vec<Shape>> {
+    shapes_at(1.0, DVec3::ZERO)
+}
+
+/// [`shapes_strategy`]'s shapes scaled by `scale` and moved by `offset`.
+fn shapes_at(scale: f64, offset: DVec3) -> impl Strategy<Value = Vec<Shape>> {
     let coord = prop_oneof![4 => -4.0..4.0f64, 1 => Just(0.0), 1 => Just(2.0), 1 => Just(-2.0)];
-    let point =
-        (coord.clone(), coord.clone(), coord.clone()).prop_map(|(x, y, z)| DVec3::new(x, y, z));
-    let offset =
-        (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64).prop_map(|(x, y, z)| DVec3::new(x, y, z));
+    let point = (coord.clone(), coord.clone(), coord.clone())
+        .prop_map(move |(x, y, z)| DVec3::new(x, y, z) * scale + offset);
+    let offset = (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64)
+        .prop_map(move |(x, y, z)| DVec3::new(x, y, z) * scale);
     let triangle = (point.clone(), offset.clone(), offset)
         .prop_filter_map("degenerate", |(a, b, c)| {
             Triangle::new([a, a + b, a + c]).map(Shape::Triangle)
         });
-    let sphere = (point, 0.05..0.8f64).prop_map(|(c, r)| Shape::Sphere(Sphere::new(c, r)));
+    let sphere =
+        (point, 0.05..0.8f64).prop_map(move |(c, r)| Shape::Sphere(Sphere::new(c, r * scale)));
     prop::collection::vec(prop_oneof![triangle, sphere], 1..60)
 }
 
@@ -90,16 +96,87 @@ proptest! {
         let one_sided: Vec<bool> = (0..shapes.len()).map(|i| one_sided_mask >> (i % 64) & 1 == 1).collect();
         let prims = Primitives { shapes: &shapes, one_sided: &one_sided, transparent: &is_transparent };
         for ray in rays {
-            let prepared = PreparedRay::new(ray);
-            let brute = closest_brute_force(&prims, &prepared, f64::INFINITY, &mut NoCounts);
-            let tree = octree.closest(&prims, &prepared, f64::INFINITY, &mut glint::accel::WalkStack::default(), &mut NoCounts);
-            prop_assert_eq!(brute, tree, "closest hit differs for {:?}", ray);
-            let mut b = ShadowCrossings::default();
-            occlusion_brute_force(&prims, &prepared, shadow_length, &mut b, &mut NoCounts);
-            // Left over from another ray: cleared by the query.
-            let mut t = b.clone();
-            octree.occlusion(&prims, &prepared, shadow_length, &mut t, &mut glint::accel::WalkStack::default(), &mut NoCounts);
-            prop_assert_eq!(b, t, "shadow verdict differs for {:?}", ray);
+            agree(&octree, &prims, ray, shadow_length)?;
         }
     }
+
+    /// The same at the extremes: scenes a millionth and a million times
+    /// the size, ten million units from the origin, and rays that start on
+    /// a shape's surface (as shadow and secondary rays do) or graze it.
+    #[test]
+    fn closest_hit_and_shadows_match_brute_force_at_the_extremes(
+        (shapes, scale, offset) in (
+            prop_oneof![Just(1e-6), Just(1.0), Just(1e6)],
+            prop_oneof![Just(0.0), Just(1e7)],
+        ).prop_flat_map(|(scale, offset)| {
+            (shapes_at(scale, DVec3::splat(offset)), Just(scale), Just(offset))
+        }),
+        rays in prop::collection::vec((ray_strategy(), 0usize..64, 0.0..1.0f64, 0.0..1.0f64), 40),
+        leaf_size in 1u32..6,
+        transparent_mask in any::<u64>(),
+    ) {
+        let octree = Octree::build(&shapes, OctreeParams { leaf_size, ..Default::default() }).unwrap();
+        let is_transparent: Vec<bool> = (0..shapes.len()).map(|i| transparent_mask >> (i % 64) & 1 == 1).collect();
+        let prims = Primitives { shapes: &shapes, one_sided: &[], transparent: &is_transparent };
+        for (ray, on, u, v) in rays {
+            let origin = ray.origin * scale + DVec3::splat(offset);
+            let ray = match &shapes[on % shapes.len()] {
+                // Every other ray starts on a triangle, inside or on an edge.
+                Shape::Triangle(t) if on % 2 == 0 => {
+                    let [a, b, c] = t.vertices;
+                    let (u, v) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
+                    Ray::new(a + (b - a) * u + (c - a) * v, ray.dir)
+                }
+                _ => Ray::new(origin, ray.dir),
+            };
+            agree(&octree, &prims, ray, 20.0 * scale)?;
+        }
+    }
+}
+
+/// The octree's closest hit and shadow verdict for `ray`, by the walk that
+/// counts nothing (the wide walk) and by the one that counts (the exact
+/// walk Havran's measures come from), equal brute force's.
+fn agree(
+    octree: &Octree,
+    prims: &Primitives,
+    ray: Ray,
+    shadow_length: f64,
+) -> Result<(), TestCaseError> {
+    let prepared = PreparedRay::new(ray);
+    let mut stack = glint::accel::WalkStack::default();
+    let brute = closest_brute_force(prims, &prepared, f64::INFINITY, &mut NoCounts);
+    let wide = octree.closest(prims, &prepared, f64::INFINITY, &mut stack, &mut NoCounts);
+    prop_assert_eq!(brute, wide, "closest hit differs for {:?}", ray);
+    let exact = octree.closest(
+        prims,
+        &prepared,
+        f64::INFINITY,
+        &mut stack,
+        &mut WorkCounts::default(),
+    );
+    prop_assert_eq!(brute, exact, "closest hit (counted) differs for {:?}", ray);
+    let mut b = ShadowCrossings::default();
+    occlusion_brute_force(prims, &prepared, shadow_length, &mut b, &mut NoCounts);
+    // Left over from another ray: cleared by the query.
+    let mut t = b.clone();
+    octree.occlusion(
+        prims,
+        &prepared,
+        shadow_length,
+        &mut t,
+        &mut stack,
+        &mut NoCounts,
+    );
+    prop_assert_eq!(&b, &t, "shadow verdict differs for {:?}", ray);
+    octree.occlusion(
+        prims,
+        &prepared,
+        shadow_length,
+        &mut t,
+        &mut stack,
+        &mut WorkCounts::default(),
+    );
+    prop_assert_eq!(&b, &t, "shadow verdict (counted) differs for {:?}", ray);
+    Ok(())
 }

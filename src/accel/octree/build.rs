@@ -4,6 +4,7 @@
 
 use rayon::prelude::*;
 
+use super::bounds::NodeBoxes;
 use super::node::LEVEL_MASK;
 use super::node::{Cell, INTERIOR, Node};
 use super::params::{OctreeError, OctreeParams, OctreeStats};
@@ -58,6 +59,7 @@ impl Octree {
                 ..OctreeStats::default()
             },
             sides: [0.0; LEVEL_MASK + 1],
+            boxes: NodeBoxes::default(),
         };
         if bounded.is_empty() {
             return Ok(tree);
@@ -109,22 +111,25 @@ impl Octree {
             .iter()
             .filter(|n| n.is_leaf() && n.count() == 0)
             .count() as u64;
+        tree.set_sides();
+        tree.boxes = NodeBoxes::build(&tree.nodes, &tree.refs, tree.root_cell(), shapes);
         tree.stats = OctreeStats {
             nodes: tree.nodes.len() as u64 + unstored,
             leaves: stored_leaves + unstored,
             empty_leaves: stored_empty + unstored,
             references: tree.refs.len() as u64,
             memory_bytes: (tree.nodes.len() * std::mem::size_of::<Node>()
-                + (tree.refs.len() + tree.unbounded.len()) * 4) as u64,
+                + (tree.refs.len() + tree.unbounded.len()) * 4) as u64
+                + tree.boxes.memory_bytes(),
             ..stats
         };
-        tree.set_sides();
         Ok(tree)
     }
 }
 
-/// Bytes one node and one reference take in the built structure.
-const NODE_BYTES: u64 = std::mem::size_of::<Node>() as u64;
+/// Bytes one node (with its box) and one reference take in the built
+/// structure.
+const NODE_BYTES: u64 = std::mem::size_of::<Node>() as u64 + NodeBoxes::BYTES_PER_NODE;
 const REF_BYTES: u64 = 4;
 /// What a node waiting for its verdict costs besides its references: the
 /// struct and its heap block's bookkeeping (an allocator's header and

@@ -23,8 +23,12 @@
 //! any point-in-box test. It runs iteratively on a small stack kept per
 //! thread (no allocation, no recursion); a node stores a mask of its
 //! non-empty children, which alone are stored and visited. Rays stop as
-//! soon as the best hit lies before the exit of the current leaf.
+//! soon as the best hit lies before the exit of the current leaf. That walk
+//! is the one Havran's measures count; a query that counts nothing takes
+//! the wide walk instead (`wide_walk.rs`): each node's children tested at
+//! once against the boxes of what they hold, with the same answers.
 
+mod bounds;
 mod build;
 mod node;
 mod packet_walk;
@@ -33,6 +37,7 @@ mod predict;
 mod tree;
 mod visit;
 mod walk;
+mod wide_walk;
 
 pub use packet_walk::PacketStack;
 pub use params::{DEFAULT_MEMORY_BUDGET_MIB, OctreeCell, OctreeError, OctreeParams, OctreeStats};

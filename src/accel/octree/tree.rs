@@ -2,6 +2,7 @@
 //! ray, and what it says of itself (statistics, cells for the overlay).
 //! Building is `build.rs`'s, the traversal `walk.rs`'s.
 
+use super::bounds::NodeBoxes;
 use super::node::LEVEL_MASK;
 use super::node::{Cell, Node};
 use super::params::{OctreeCell, OctreeParams, OctreeStats};
@@ -19,6 +20,8 @@ pub struct Octree {
     /// The side of a cell at each level, halved from the root's exactly as
     /// the build halves it.
     pub(super) sides: [f64; LEVEL_MASK + 1],
+    /// The box of what each stored node holds, for the wide walk.
+    pub(super) boxes: NodeBoxes,
 }
 
 impl Octree {

@@ -1,5 +1,6 @@
-//! What the two walks share: the single-ray walk (`walk.rs`, Revelles'
-//! sequence of children for one ray) and the packet walk (`packet_walk.rs`,
+//! What the walks share: the single-ray walk (`walk.rs`, Revelles'
+//! sequence of children for one ray, and `wide_walk.rs`, eight children's
+//! boxes at once when nothing is counted) and the packet walk (`packet_walk.rs`,
 //! a fixed front-to-back order of octants for rays that share signs) are
 //! different algorithms around the same parts, written here once: the stack
 //! of cells waiting to be visited, the mailbox that tests a shape once per
@@ -18,6 +19,7 @@
 
 use crate::simd::F64s;
 use crate::stats::Counter;
+use crate::stats::walk_record::WalkEnd;
 
 /// The ray parameters a walk carries per cell: one `f64` for a single ray,
 /// one per lane for a packet.
@@ -123,6 +125,16 @@ pub(super) trait Visitor {
     /// Cells starting beyond the limit cannot change the answer.
     fn limit(&self) -> Self::Limit;
     fn counter(&mut self) -> &mut Self::C;
+}
+
+/// What a single ray's walk does at its leaves.
+pub(super) trait LeafVisitor: Visitor<Limit = f64> {
+    /// Tests the shapes of a leaf the ray leaves at `t_exit`; `true` to stop.
+    fn visit_leaf(&mut self, refs: &[u32], t_exit: f64) -> bool;
+    /// Why the walk ends when `visit_leaf` says stop, and when the next
+    /// cell starts beyond the limit.
+    const STOPPED: WalkEnd;
+    const BEYOND_LIMIT: WalkEnd;
 }
 
 #[cfg(test)]

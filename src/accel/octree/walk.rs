@@ -4,7 +4,8 @@
 
 use super::node::{LEVEL_MASK, child_corner};
 use super::tree::Octree;
-use super::visit::{CellEntry, CellStack, Mailbox, Visitor};
+use super::visit::{CellEntry, CellStack, LeafVisitor, Mailbox, Visitor};
+use super::wide_walk::WideStack;
 use crate::accel::primitives::{
     ClosestHit, Primitives, ShadowCrossings, test_closest, test_occlusion,
 };
@@ -34,8 +35,12 @@ impl Octree {
         for &i in &self.unbounded {
             test_closest(prims, i, ray, &mut visitor.best, t_max, visitor.counter);
         }
-        let limit = visitor.limit();
-        self.walk(ray, limit, stack, &mut visitor);
+        if !C::COUNTS && self.has_boxes() {
+            self.walk_wide(ray, &mut stack.wide, &mut visitor);
+        } else {
+            let limit = visitor.limit();
+            self.walk(ray, limit, stack, &mut visitor);
+        }
         visitor.best
     }
 
@@ -65,7 +70,11 @@ impl Octree {
             mailbox: Mailbox::new(),
             counter,
         };
-        self.walk(ray, t_max, stack, &mut visitor);
+        if !C::COUNTS && self.has_boxes() {
+            self.walk_wide(ray, &mut stack.wide, &mut visitor);
+        } else {
+            self.walk(ray, t_max, stack, &mut visitor);
+        }
     }
 
     /// The ray's parameter range inside the root cell, clipped to
@@ -117,7 +126,7 @@ impl Octree {
         };
         let o = ray.ray.origin.to_array();
         let inv = ray.inv_dir;
-        let entries = stack.entries();
+        let entries = stack.cells.entries();
         entries[0] = CellEntry {
             min: self.bounds.min.to_array(),
             t0,
@@ -256,17 +265,12 @@ impl Octree {
 /// masked instead of bounds-checked).
 const STACK_CAPACITY: usize = (3 * MAX_OCTREE_DEPTH as usize + 4).next_power_of_two();
 
-/// A single ray's walk stack.
-pub type WalkStack = CellStack<f64, STACK_CAPACITY>;
-
-/// What a single ray's walk does at its leaves.
-trait LeafVisitor: Visitor<Limit = f64> {
-    /// Tests the shapes of a leaf the ray leaves at `t_exit`; `true` to stop.
-    fn visit_leaf(&mut self, refs: &[u32], t_exit: f64) -> bool;
-    /// Why the walk ends when `visit_leaf` says stop, and when the next
-    /// cell starts beyond the limit.
-    const STOPPED: WalkEnd;
-    const BEYOND_LIMIT: WalkEnd;
+/// A single ray's walk stacks: the exact walk's cells and the wide walk's
+/// nodes. Scratch space the caller owns (one per tile), so no ray sets it up.
+#[derive(Default)]
+pub struct WalkStack {
+    cells: CellStack<f64, STACK_CAPACITY>,
+    wide: WideStack,
 }
 
 struct ClosestVisitor<'a, C> {

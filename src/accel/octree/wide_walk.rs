@@ -1,0 +1,125 @@
+//! The single-ray walk when nothing is counted: a node's children are
+//! tested eight at once against the boxes of what they hold
+//! (`bounds.rs`), as a BVH with eight-wide nodes is (Embree; Wald et al.
+//! 2008, "Getting Rid of Packets"), and the children the ray meets are
+//! visited nearest entry first. A cell whose box starts beyond the best
+//! hit so far is skipped. The answer is the exact walk's (`walk.rs`):
+//! every shape that could hold the closest hit or block the light is
+//! tested, in `f64`, and the closest hit is the lexicographic minimum of
+//! `(t, shape index)` whatever the order of the tests. Havran's measures
+//! count the exact walk's cells, so a counted query takes that walk.
+
+use super::bounds::{BoxRay, limit_f32};
+use super::tree::Octree;
+use super::visit::LeafVisitor;
+use crate::limits::MAX_OCTREE_DEPTH;
+use crate::shapes::PreparedRay;
+
+/// Room on the stack: each level leaves at most seven siblings waiting,
+/// plus the node being entered (a power of two, so indices are masked).
+const CAPACITY: usize = (7 * (MAX_OCTREE_DEPTH as usize + 1) + 1).next_power_of_two();
+
+/// A node waiting on the stack, and where the ray may enter its box.
+#[derive(Clone, Copy, Debug, Default)]
+struct Waiting {
+    node: u32,
+    entry: f32,
+}
+
+/// The wide walk's stack: scratch space the caller owns, like
+/// `WalkStack` (`walk.rs`), which holds it.
+pub(super) struct WideStack {
+    entries: Box<[Waiting; CAPACITY]>,
+}
+
+impl Default for WideStack {
+    fn default() -> Self {
+        Self {
+            entries: Box::new([Waiting::default(); CAPACITY]),
+        }
+    }
+}
+
+impl Octree {
+    /// Whether the wide walk can run on this tree (its boxes exist).
+    #[inline(always)]
+    pub(super) fn has_boxes(&self) -> bool {
+        !self.boxes.is_empty()
+    }
+
+    /// Visits the leaves whose boxes `ray` meets before the visitor's
+    /// limit, nearest first, until the visitor says stop.
+    #[inline(always)]
+    pub(super) fn walk_wide<V: LeafVisitor>(
+        &self,
+        ray: &PreparedRay,
+        stack: &mut WideStack,
+        visitor: &mut V,
+    ) {
+        let boxes = &self.boxes;
+        let box_ray = BoxRay::new(ray, &self.root_cell());
+        let (root, entry) = boxes.hit(0, 1, &box_ray, limit_f32(visitor.limit()));
+        if root == 0 {
+            return;
+        }
+        let entries = &mut *stack.entries;
+        entries[0] = Waiting {
+            node: 0,
+            entry: entry[0],
+        };
+        let mut top = 1usize;
+        while top > 0 {
+            top -= 1;
+            let waiting = entries[top & (CAPACITY - 1)];
+            // The limit only falls: a box entered past it holds nothing
+            // that could change the answer.
+            let limit = limit_f32(visitor.limit());
+            if waiting.entry > limit {
+                continue;
+            }
+            let mut index = waiting.node;
+            loop {
+                let node = self.nodes[index as usize];
+                if node.is_leaf() {
+                    let first = node.first as usize;
+                    let refs = &self.refs[first..first + node.count() as usize];
+                    if visitor.visit_leaf(refs, f64::NEG_INFINITY) {
+                        return;
+                    }
+                    break;
+                }
+                let first = node.first;
+                let (mut hits, entry) =
+                    boxes.hit(first as usize, node.mask().count_ones(), &box_ray, limit);
+                if hits == 0 {
+                    break;
+                }
+                if hits & (hits - 1) == 0 {
+                    // One child: enter it without the stack.
+                    index = first + hits.trailing_zeros();
+                    continue;
+                }
+                // Every child met, kept sorted farthest first above the
+                // waiting ones, so the nearest is entered next.
+                let base = top;
+                while hits != 0 {
+                    let j = hits.trailing_zeros();
+                    hits &= hits - 1;
+                    let child = Waiting {
+                        node: first + j,
+                        entry: entry[j as usize],
+                    };
+                    let mut at = top;
+                    while at > base && entries[(at - 1) & (CAPACITY - 1)].entry < child.entry {
+                        entries[at & (CAPACITY - 1)] = entries[(at - 1) & (CAPACITY - 1)];
+                        at -= 1;
+                    }
+                    entries[at & (CAPACITY - 1)] = child;
+                    top += 1;
+                }
+                top -= 1;
+                index = entries[top & (CAPACITY - 1)].node;
+            }
+        }
+    }
+}
