@@ -173,6 +173,39 @@ pub fn dispatch<W: LaneWork>(level: SimdLevel, work: W) -> Option<W::Output> {
     }
 }
 
+/// Whether coherent rays are traced in packets: yes unless the environment
+/// variable `GLINT_PACKETS` is `off`, which traces every ray on its own at
+/// the same SIMD level (to measure the single-ray walk on any workload;
+/// the bytes are the same). Read once.
+pub fn packets_enabled() -> bool {
+    static ENABLED: OnceLock<bool> = OnceLock::new();
+    *ENABLED.get_or_init(|| std::env::var("GLINT_PACKETS").map_or(true, |v| v != "off"))
+}
+
+/// Where single rays' queries run: in a function compiled for AVX2 when
+/// the level has it (the wide walk's eight boxes then take one register),
+/// in baseline x86-64 code otherwise. The token is taken once per render,
+/// so a query pays a call, not a check of the CPU.
+#[derive(Clone, Copy, Debug)]
+pub struct SingleRays(Option<pulp::x86::V3>);
+
+impl SingleRays {
+    /// AVX2 at the AVX2 and AVX-512 levels (AVX-512's wider registers
+    /// give a single ray nothing), baseline at the scalar level.
+    pub fn at(level: SimdLevel) -> Self {
+        Self(match level {
+            SimdLevel::Scalar => None,
+            SimdLevel::Avx2 | SimdLevel::Avx512 => pulp::x86::V3::try_new(),
+        })
+    }
+
+    /// The AVX2 token single rays' work runs with (`None`: baseline).
+    #[inline(always)]
+    pub fn avx2(self) -> Option<pulp::x86::V3> {
+        self.0
+    }
+}
+
 /// Adapts [`LaneWork`] to pulp: the lane count is the instruction set's
 /// number of `f64` lanes, and `run` is inlined into the function pulp
 /// compiles for that instruction set.

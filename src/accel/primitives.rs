@@ -6,7 +6,6 @@
 #![allow(clippy::needless_range_loop)]
 
 use crate::shapes::{PacketHits, PreparedRay, RayPacket, Shape, ShapeHit, probe_past, wins};
-use crate::simd::F64s;
 use crate::stats::Counter;
 
 /// The shapes a ray query runs over, and what it must know of each.
@@ -87,39 +86,6 @@ impl<'a> Primitives<'a> {
                         best.merge(index, 1 << i, t, b1, b2);
                     }
                 }
-            }
-        }
-    }
-
-    /// The `lanes` of a packet of shadow rays that shape `index` blocks
-    /// within each lane's `t_max` (for scenes without transparent shapes:
-    /// any hit blocks, as in [`test_occlusion`]).
-    #[inline(always)]
-    pub(crate) fn blocked_lanes<C: Counter, const N: usize>(
-        &self,
-        index: u32,
-        p: &RayPacket<N>,
-        t_max: &F64s<N>,
-        lanes: u32,
-        counter: &mut C,
-    ) -> u32 {
-        counter.add_lanes(lanes.count_ones(), 0, 0);
-        match &self.shapes[index as usize] {
-            Shape::Triangle(t) if self.one_sided.get(index as usize) != Some(&true) => {
-                t.intersect_lanes(p, t_max).hit & lanes
-            }
-            Shape::Sphere(s) if self.one_sided.get(index as usize) != Some(&true) => {
-                s.intersect_lanes(p, t_max).hit & lanes
-            }
-            _ => {
-                let mut blocked = 0;
-                for i in 0..N {
-                    if lanes >> i & 1 == 1 && self.intersect(index, &p.lane(i), t_max[i]).is_some()
-                    {
-                        blocked |= 1 << i;
-                    }
-                }
-                blocked
             }
         }
     }

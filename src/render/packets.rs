@@ -1,19 +1,20 @@
 //! Tiles traced in packets: the eye rays of neighbouring pixels (or a
-//! pixel's samples, or neighbouring corners) walk the octree together,
-//! and the shadow rays of their hits towards one light do too. Each lane
-//! is then shaded by the same code, operation for operation, as a single
-//! ray: the pixels are the single-ray path's, byte for byte, at every SIMD
-//! level. The eye hits' reflection rays, and their refraction rays, are
-//! grouped the same way, with the shadow rays of their hits (a mirror's or
-//! a glass sphere's neighbouring pixels stay coherent); deeper rays go one
-//! by one: they scatter. Packets need coherent rays (one sign pattern and
-//! axis permutation, none parallel to an axis plane); any other group
-//! falls back to single rays, lane by lane.
+//! pixel's samples, or neighbouring corners) walk the octree together for
+//! their closest hits. Each lane is then shaded by the same code, operation
+//! for operation, as a single ray: the pixels are the single-ray path's,
+//! byte for byte, at every SIMD level. The hits' refraction rays, then
+//! their reflection rays, are grouped the same way at every depth (a
+//! mirror's or a glass sphere's neighbouring pixels stay coherent).
+//! Shadow rays go one by one through the wide walk, which skips the empty
+//! part of each cell: in packets they cost more on the SPD scenes
+//! (docs/notes/experiments.md). Packets need coherent rays (one sign
+//! pattern and axis permutation, none parallel to an axis plane); any
+//! other group falls back to single rays, lane by lane.
 
 // Lane loops index several arrays by the same lane number.
 #![allow(clippy::needless_range_loop)]
 
-use crate::accel::{ClosestHit, PacketStack, Primitives, ShadowCrossings};
+use crate::accel::{ClosestHit, PacketStack, Primitives};
 use crate::math::{Color, DVec3, Ray};
 use crate::render::ray_tree::{NoRecord, RayKind, RayRecorder};
 use crate::shapes::{PacketHits, PreparedRay, RayPacket, ShapeHit};
@@ -26,11 +27,9 @@ use super::renderer::{Query, Renderer, Scratch};
 use super::tile_job::{PixelSum, TileJob, TileOutput, keep_scratch, spare_scratch};
 use super::tiles::Tile;
 
-/// Scratch space for a tile's packets: the walk's stack and each lane's
-/// shadow crossings.
+/// Scratch space for a tile's packets: the walk's stack.
 pub(super) struct PacketScratch<const N: usize> {
     walk: PacketStack<N>,
-    crossings: [ShadowCrossings; N],
 }
 
 /// A tile's job, run by [`crate::simd::dispatch`] with the level's lanes.
@@ -90,34 +89,6 @@ impl<C: Counter, const N: usize> pulp::WithSimd for ClosestWalk<'_, '_, '_, C, N
     }
 }
 
-/// A shadow packet's walk, as a function of its own per SIMD level (see
-/// [`ClosestWalk`]).
-struct OcclusionWalk<'w, 'r, 'a, C, const N: usize> {
-    renderer: &'r Renderer<'a>,
-    prims: &'w Primitives<'r>,
-    packet: &'w RayPacket<N>,
-    lengths: &'w [f64; N],
-    found: &'w mut [ShadowCrossings; N],
-    stack: &'w mut PacketStack<N>,
-    counter: &'w mut C,
-}
-
-impl<C: Counter, const N: usize> pulp::WithSimd for OcclusionWalk<'_, '_, '_, C, N> {
-    type Output = u32;
-
-    #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _simd: S) -> u32 {
-        self.renderer.octree.occlusion_packet(
-            self.prims,
-            self.packet,
-            *self.lengths,
-            self.found,
-            self.stack,
-            self.counter,
-        )
-    }
-}
-
 /// The secondary rays of a packet's hits, as a function of its own per
 /// SIMD level (see [`ClosestWalk`]): inlined into the eye rays' function,
 /// its size cost the scenes without secondary rays 3 % of their
@@ -159,7 +130,6 @@ impl<const N: usize> Default for PacketScratch<N> {
     fn default() -> Self {
         Self {
             walk: PacketStack::default(),
-            crossings: std::array::from_fn(|_| ShadowCrossings::default()),
         }
     }
 }
@@ -390,13 +360,11 @@ impl Renderer<'_> {
         let mut colors = [Color::ZERO; N];
         let mut points: [Option<ShadingPoint>; N] = [const { None }; N];
         self.direct_lanes(
-            simd,
             rays,
             hits,
             &mut points,
             &mut colors,
             query,
-            stack,
             ray_counts,
             recs,
         );
@@ -425,20 +393,19 @@ impl Renderer<'_> {
 
     /// The shading points of `rays`' hits into `points` (left `None`
     /// where a ray has none) and their local colours into `colors`:
-    /// ambient, then each light's term in turn with the shadow rays towards
-    /// it traced together ([`Renderer::direct_light`] for each ray). A ray
-    /// without a hit gets the background, told to its recorder as final.
+    /// ambient, then each light's term in turn ([`Renderer::direct_light`]
+    /// for each ray). A ray without a hit gets the background, told to its
+    /// recorder as final.
+    // The single-ray shading's arguments, in lanes.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn direct_lanes<S: pulp::Simd, C: Counter, R: RayRecorder, const N: usize>(
+    fn direct_lanes<C: Counter, R: RayRecorder, const N: usize>(
         &self,
-        simd: S,
         rays: &[Ray],
         hits: &[Option<ClosestHit>; N],
         points: &mut [Option<ShadingPoint>; N],
         colors: &mut [Color; N],
         query: &mut Query<C>,
-        stack: &mut PacketScratch<N>,
         ray_counts: &mut RayCounts,
         recs: &mut [R; N],
     ) {
@@ -469,7 +436,7 @@ impl Renderer<'_> {
                     .and_then(|at| self.toward_light(at, origins[k], light))
             });
             let passes = if self.settings.shadows {
-                self.transmittance_lanes(simd, &origins, &toward, query, stack, ray_counts)
+                self.transmittance_lanes(&origins, &toward, query, ray_counts)
             } else {
                 [1.0; N]
             };
@@ -556,13 +523,11 @@ impl Renderer<'_> {
             let mut child_colors = [Color::ZERO; N];
             let mut child_points: [Option<ShadingPoint>; N] = [const { None }; N];
             self.direct_lanes(
-                simd,
                 child_rays,
                 &hits,
                 &mut child_points,
                 &mut child_colors,
                 query,
-                stack,
                 ray_counts,
                 &mut crecs,
             );
@@ -608,61 +573,24 @@ impl Renderer<'_> {
     }
 
     /// What each shadow ray towards one light lets through (`toward`: its
-    /// direction and length, `None` where none is cast): one packet in a
-    /// scene of opaque shapes, one by one otherwise (crossings of
-    /// transparent shapes are kept in order per ray).
+    /// direction and length, `None` where none is cast), each traced on its
+    /// own by the wide walk: in packets, shadow rays cost more than single
+    /// rays on the SPD scenes (docs/notes/experiments.md).
     #[inline(always)]
-    fn transmittance_lanes<S: pulp::Simd, C: Counter, const N: usize>(
+    fn transmittance_lanes<C: Counter, const N: usize>(
         &self,
-        simd: S,
         origins: &[DVec3; N],
         toward: &[Option<(DVec3, f64, f64)>; N],
         query: &mut Query<C>,
-        stack: &mut PacketScratch<N>,
         ray_counts: &mut RayCounts,
     ) -> [f64; N] {
         let mut passes = [1.0; N];
-        let mut lanes = [0usize; N];
-        let mut rays = [Ray::new(DVec3::ZERO, DVec3::X); N];
-        let mut lengths = [0.0; N];
-        let mut n = 0;
         for k in 0..N {
             if let Some((l, distance, _)) = toward[k] {
-                lanes[n] = k;
-                rays[n] = Ray::new(origins[k], l);
-                lengths[n] = distance;
-                n += 1;
+                ray_counts.shadow += 1;
+                let ray = PreparedRay::new(Ray::new(origins[k], l));
+                passes[k] = self.transmittance(&ray, distance, query);
             }
-        }
-        ray_counts.shadow += n as u64;
-        if n == 0 {
-            return passes;
-        }
-        if self.settings.use_octree
-            && let Some(packet) = RayPacket::<N>::from_rays(&rays[..n])
-        {
-            let prims = self.primitives();
-            let found = &mut stack.crossings;
-            let blocked = simd.vectorize(OcclusionWalk {
-                renderer: self,
-                prims: &prims,
-                packet: &packet,
-                lengths: &lengths,
-                found,
-                stack: &mut stack.walk,
-                counter: &mut *query.counter,
-            });
-            for (m, &k) in lanes[..n].iter().enumerate() {
-                passes[k] = if blocked >> m & 1 == 1 {
-                    0.0
-                } else {
-                    self.pass_through(&found[m])
-                };
-            }
-            return passes;
-        }
-        for (m, &k) in lanes[..n].iter().enumerate() {
-            passes[k] = self.transmittance(&PreparedRay::new(rays[m]), lengths[m], query);
         }
         passes
     }

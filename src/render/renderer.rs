@@ -15,8 +15,8 @@ use crate::render::ray_tree::{RayKind, RayNode};
 use crate::scene::Scene;
 use crate::settings::{RenderSettings, Sides, ViewMode};
 use crate::shapes::PreparedRay;
-use crate::simd::SimdLevel;
-use crate::stats::{Counter, RayCounts};
+use crate::simd::{SimdLevel, SingleRays};
+use crate::stats::{Counter, NoCounts, RayCounts};
 
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
@@ -54,6 +54,61 @@ pub(super) struct Query<'s, C> {
     pub scratch: &'s mut Scratch,
 }
 
+/// A single ray's closest hit (nothing counted), as a function compiled
+/// for the render's SIMD level ([`SingleRays`]).
+struct ClosestQuery<'q> {
+    octree: &'q Octree,
+    prims: &'q Primitives<'q>,
+    ray: &'q PreparedRay,
+    stack: &'q mut WalkStack,
+    simd: pulp::x86::V3,
+}
+
+impl pulp::WithSimd for ClosestQuery<'_> {
+    type Output = Option<ClosestHit>;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) -> Option<ClosestHit> {
+        self.octree.closest_inline(
+            self.prims,
+            self.ray,
+            f64::INFINITY,
+            self.stack,
+            &mut NoCounts,
+            self.simd,
+        )
+    }
+}
+
+/// A shadow ray's crossings (nothing counted), as a function compiled for
+/// the render's SIMD level ([`SingleRays`]).
+struct OcclusionQuery<'q> {
+    octree: &'q Octree,
+    prims: &'q Primitives<'q>,
+    ray: &'q PreparedRay,
+    distance: f64,
+    crossings: &'q mut ShadowCrossings,
+    stack: &'q mut WalkStack,
+    simd: pulp::x86::V3,
+}
+
+impl pulp::WithSimd for OcclusionQuery<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+        self.octree.occlusion_inline(
+            self.prims,
+            self.ray,
+            self.distance,
+            self.crossings,
+            self.stack,
+            &mut NoCounts,
+            self.simd,
+        );
+    }
+}
+
 /// Crossings of one material closer than this, relative to the scene's
 /// magnitude, are one surface: far above the rounding of hit distances,
 /// far below any thickness a scene models.
@@ -81,6 +136,8 @@ pub struct Renderer<'a> {
     pub(super) floor_scale: f64,
     /// Packets of this many lanes where rays are coherent (1: single rays).
     pub(super) simd: SimdLevel,
+    /// Where single rays' octree queries run (AVX2 or baseline code).
+    pub(super) single_rays: SingleRays,
 }
 
 impl<'a> Renderer<'a> {
@@ -146,7 +203,12 @@ impl<'a> Renderer<'a> {
                 .grow(camera.eye)
                 .max_abs()
                 .max(f64::MIN_POSITIVE),
-            simd: SimdLevel::current(),
+            simd: if crate::simd::packets_enabled() {
+                SimdLevel::current()
+            } else {
+                SimdLevel::Scalar
+            },
+            single_rays: SingleRays::at(SimdLevel::current()),
         })
     }
 
@@ -162,7 +224,13 @@ impl<'a> Renderer<'a> {
     /// most the best: a level the machine lacks runs its best). The bytes
     /// are the same at every level; only the time differs.
     pub fn with_simd(mut self, level: SimdLevel) -> Self {
-        self.simd = level.min(SimdLevel::best());
+        let level = level.min(SimdLevel::best());
+        self.single_rays = SingleRays::at(level);
+        self.simd = if crate::simd::packets_enabled() {
+            level
+        } else {
+            SimdLevel::Scalar
+        };
         self
     }
 
@@ -187,6 +255,20 @@ impl<'a> Renderer<'a> {
         let prims = self.primitives();
         if self.settings.use_octree {
             let stack = &mut query.scratch.stack;
+            if !C::COUNTS
+                && let Some(simd) = self.single_rays.avx2()
+            {
+                return pulp::Simd::vectorize(
+                    simd,
+                    ClosestQuery {
+                        octree: self.octree,
+                        prims: &prims,
+                        ray,
+                        stack,
+                        simd,
+                    },
+                );
+            }
             self.octree
                 .closest(&prims, ray, f64::INFINITY, stack, query.counter)
         } else {
@@ -210,8 +292,23 @@ impl<'a> Renderer<'a> {
         let prims = self.primitives();
         let Scratch { stack, crossings } = &mut *query.scratch;
         if self.settings.use_octree {
-            self.octree
-                .occlusion(&prims, ray, distance, crossings, stack, query.counter);
+            match self.single_rays.avx2() {
+                Some(simd) if !C::COUNTS => pulp::Simd::vectorize(
+                    simd,
+                    OcclusionQuery {
+                        octree: self.octree,
+                        prims: &prims,
+                        ray,
+                        distance,
+                        crossings,
+                        stack,
+                        simd,
+                    },
+                ),
+                _ => self
+                    .octree
+                    .occlusion(&prims, ray, distance, crossings, stack, query.counter),
+            }
         } else {
             occlusion_brute_force(&prims, ray, distance, crossings, query.counter);
         }

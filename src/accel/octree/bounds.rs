@@ -37,16 +37,56 @@ const SIDE_RANGE: std::ops::RangeInclusive<f64> = 1e-30..=1e30;
 /// only adds visits), so no product can overflow into a NaN.
 const MAX_INVERSE: f64 = 1e30;
 
-/// Each stored node's box: `planes[2k]` the lowest coordinate along axis
-/// `k`, `planes[2k + 1]` the highest, relative to the root's corner.
+/// The boxes of an interior node's children, one lane each in storage
+/// order, as six planes of eight lanes: `planes[2k]` the lowest coordinate
+/// along axis `k`, `planes[2k + 1]` the highest, relative to the root's
+/// corner. Lanes past the children hold an empty box. One aligned block
+/// per interior node: a node's test loads six registers, no more.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(32))]
+pub struct Block {
+    planes: [[f32; WIDTH]; 6],
+}
+
+impl Block {
+    /// The planes a ray meets first and last along axis `k` (`k` < 3),
+    /// by the sign of its direction.
+    #[inline(always)]
+    fn near_far(&self, k: usize, negative: bool) -> (&[f32; WIDTH], &[f32; WIDTH]) {
+        let (lo, hi) = match k {
+            0 => (&self.planes[0], &self.planes[1]),
+            1 => (&self.planes[2], &self.planes[3]),
+            _ => (&self.planes[4], &self.planes[5]),
+        };
+        if negative { (hi, lo) } else { (lo, hi) }
+    }
+
+    const EMPTY: Block = Block {
+        planes: [
+            [f32::MAX; WIDTH],
+            [-f32::MAX; WIDTH],
+            [f32::MAX; WIDTH],
+            [-f32::MAX; WIDTH],
+            [f32::MAX; WIDTH],
+            [-f32::MAX; WIDTH],
+        ],
+    };
+}
+
+/// The boxes of what each node holds: a [`Block`] per interior node (of
+/// its children's boxes) and one for the root's own box (lane 0).
 #[derive(Clone, Debug, Default)]
-pub(super) struct NodeBoxes {
-    planes: [Vec<f32>; 6],
+pub struct NodeBoxes {
+    blocks: Vec<Block>,
+    /// Per stored node: its block (interior nodes), or `u32::MAX`.
+    block_of: Vec<u32>,
 }
 
 impl NodeBoxes {
-    /// Bytes per stored node.
-    pub(super) const BYTES_PER_NODE: u64 = 6 * 4;
+    /// Bytes per stored node (its block index) and per interior node (its
+    /// children's block).
+    pub(super) const BYTES_PER_NODE: u64 = 4;
+    pub(super) const BYTES_PER_INTERIOR_NODE: u64 = std::mem::size_of::<Block>() as u64;
 
     /// The boxes of a tree's nodes (`nodes` and `refs` in the root cell
     /// `root`) over `shapes`; empty when the root's size is outside what
@@ -55,64 +95,73 @@ impl NodeBoxes {
         if nodes.is_empty() || !SIDE_RANGE.contains(&root.side) {
             return Self::default();
         }
-        // Node count plus a node's width of padding: eight lanes can be
-        // read from any node, and lanes past a node's children are masked.
-        let len = nodes.len() + WIDTH;
-        let empty_lo = vec![f32::MAX; len];
-        let empty_hi = vec![-f32::MAX; len];
         let mut boxes = Self {
-            planes: [
-                empty_lo.clone(),
-                empty_hi.clone(),
-                empty_lo.clone(),
-                empty_hi.clone(),
-                empty_lo,
-                empty_hi,
-            ],
+            // Block 0: the root's own box.
+            blocks: vec![Block::EMPTY],
+            block_of: vec![u32::MAX; nodes.len()],
         };
-        let pad = PAD_RELATIVE * root.side;
         let mut fill = Fill {
             nodes,
             refs,
             shapes,
             origin: root.min,
-            pad,
+            pad: PAD_RELATIVE * root.side,
             boxes: &mut boxes,
         };
-        fill.node(0, root);
+        let held = fill.node(0, root);
+        fill.set(0, 0, held);
         boxes
     }
 
     pub(super) fn is_empty(&self) -> bool {
-        self.planes[0].is_empty()
+        self.blocks.is_empty()
     }
 
     pub(super) fn memory_bytes(&self) -> u64 {
-        self.planes.iter().map(|p| p.len() as u64 * 4).sum()
+        (self.blocks.len() * std::mem::size_of::<Block>() + self.block_of.len() * 4) as u64
     }
 
-    /// The lanes of nodes `first .. first + count` (at most eight) whose box
-    /// `ray` may meet before `limit` (from [`limit_f32`]), and where it may
-    /// enter each (not before 0): never a lane it does meet, nor a later
-    /// entry.
+    /// The root's box, in lane 0.
     #[inline(always)]
-    pub(super) fn hit(
-        &self,
-        first: usize,
-        count: u32,
-        ray: &BoxRay,
-        limit: f32,
-    ) -> (u32, [f32; 8]) {
-        let plane = |p: usize| -> &[f32; WIDTH] {
-            match self.planes[p].get(first..first + WIDTH) {
-                Some(s) => s.try_into().unwrap_or(&[0.0; WIDTH]),
-                None => &[0.0; WIDTH],
-            }
-        };
+    pub(super) fn root(&self) -> &Block {
+        self.blocks.first().unwrap_or(&Block::EMPTY)
+    }
+
+    /// The boxes of interior node `node`'s children.
+    #[inline(always)]
+    pub(super) fn children(&self, node: u32) -> &Block {
+        let block = self.block_of.get(node as usize).copied().unwrap_or(0);
+        self.blocks.get(block as usize).unwrap_or(&Block::EMPTY)
+    }
+}
+
+/// How the eight boxes of a node's children are tested: the lanes' code
+/// for a SIMD level. Each answers the same (see [`BoxLanes::hit`]).
+pub trait BoxLanes: Copy {
+    /// The lanes `0 .. count` (at most eight) of `block` whose box `ray`
+    /// may meet before `limit` (from [`limit_f32`]), and where it
+    /// may enter each (not before 0): never a lane it does meet, nor a
+    /// later entry.
+    ///
+    /// With the origin rounded away from each plane, a parameter's sign is
+    /// exact and its size off by a few roundings at most, which `WIDEN`
+    /// covers: the ray meets the box if it enters before it leaves, does
+    /// not leave it behind the origin, and enters before the limit
+    /// (widened by `limit_f32`).
+    fn hit(self, block: &Block, count: u32, ray: &BoxRay, limit: f32) -> (u32, [f32; WIDTH]);
+}
+
+/// Baseline x86-64 (or any machine): plain loops over the lanes.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Baseline;
+
+impl BoxLanes for Baseline {
+    #[inline(always)]
+    fn hit(self, block: &Block, count: u32, ray: &BoxRay, limit: f32) -> (u32, [f32; WIDTH]) {
         let mut near = [f32::NEG_INFINITY; WIDTH];
         let mut far = [f32::INFINITY; WIDTH];
         for k in 0..3 {
-            let (np, fp) = (plane(ray.near_plane[k]), plane(ray.far_plane[k]));
+            let (np, fp) = block.near_far(k, ray.negative[k]);
             let (no, fo, inv) = (ray.near_origin[k], ray.far_origin[k], ray.inv[k]);
             for j in 0..WIDTH {
                 let a = (np[j] - no) * inv;
@@ -121,11 +170,6 @@ impl NodeBoxes {
                 far[j] = if b < far[j] { b } else { far[j] };
             }
         }
-        // With the origin rounded away from each plane, a parameter's sign
-        // is exact and its size off by a few roundings at most, which
-        // `WIDEN` covers: the ray meets the box if it enters before it
-        // leaves, does not leave it behind the origin, and enters before
-        // the limit (widened by `limit_f32`).
         let mut mask = 0u32;
         let mut entry = [0.0f32; WIDTH];
         for j in 0..WIDTH {
@@ -138,15 +182,52 @@ impl NodeBoxes {
     }
 }
 
+/// AVX2: the eight lanes in one register, the same operations in the same
+/// order as [`Baseline`] (no NaN can arise, so `max` and `min` agree).
+impl BoxLanes for pulp::x86::V3 {
+    #[inline(always)]
+    fn hit(self, block: &Block, count: u32, ray: &BoxRay, limit: f32) -> (u32, [f32; WIDTH]) {
+        use pulp::{Simd, cast, f32x8};
+        let simd = self;
+        let mut near = simd.splat_f32s(f32::NEG_INFINITY);
+        let mut far = simd.splat_f32s(f32::INFINITY);
+        for k in 0..3 {
+            let (np, fp) = block.near_far(k, ray.negative[k]);
+            let (np, fp): (f32x8, f32x8) = (cast(*np), cast(*fp));
+            let (no, fo) = (
+                simd.splat_f32s(ray.near_origin[k]),
+                simd.splat_f32s(ray.far_origin[k]),
+            );
+            let inv = simd.splat_f32s(ray.inv[k]);
+            let a = simd.mul_f32s(simd.sub_f32s(np, no), inv);
+            let b = simd.mul_f32s(simd.sub_f32s(fp, fo), inv);
+            near = simd.max_f32s(near, a);
+            far = simd.min_f32s(far, b);
+        }
+        let zero = simd.splat_f32s(0.0);
+        let widened = simd.mul_f32s(far, simd.splat_f32s(1.0 + 2.0 * WIDEN));
+        let meets = simd.and_m32s(
+            simd.and_m32s(
+                simd.less_than_or_equal_f32s(near, widened),
+                simd.greater_than_or_equal_f32s(far, zero),
+            ),
+            simd.less_than_or_equal_f32s(near, simd.splat_f32s(limit)),
+        );
+        let mask = simd.avx._mm256_movemask_ps(cast(meets)) as u32;
+        let entry: [f32; WIDTH] = cast(simd.max_f32s(near, zero));
+        (mask & ((1u32 << count) - 1), entry)
+    }
+}
+
 /// A ray prepared for [`NodeBoxes::hit`]: per axis, the planes it meets
 /// first and last (by its direction's sign), its origin relative to the
 /// root rounded away from each (so the near parameter can only fall and
 /// the far one only rise, and both keep their exact sign), and its
 /// reciprocal direction.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct BoxRay {
-    near_plane: [usize; 3],
-    far_plane: [usize; 3],
+pub struct BoxRay {
+    /// Per axis: the direction is negative (the near plane is the high one).
+    negative: [bool; 3],
     near_origin: [f32; 3],
     far_origin: [f32; 3],
     inv: [f32; 3],
@@ -155,21 +236,30 @@ pub(super) struct BoxRay {
 impl BoxRay {
     #[inline(always)]
     pub(super) fn new(ray: &PreparedRay, root: &Cell) -> Self {
-        let o = (ray.ray.origin - root.min).to_array();
-        let mut near_plane = [0; 3];
-        let mut far_plane = [0; 3];
+        Self::from_parts(ray.ray.origin.to_array(), ray.inv_dir, root)
+    }
+
+    /// The ray from `origin` whose reciprocal direction is `inv_dir` (0
+    /// where it is parallel to an axis's planes).
+    #[inline(always)]
+    pub(super) fn from_parts(origin: [f64; 3], inv_dir: [f64; 3], root: &Cell) -> Self {
+        let o = [
+            origin[0] - root.min.x,
+            origin[1] - root.min.y,
+            origin[2] - root.min.z,
+        ];
+        let mut negative_axes = [false; 3];
         let mut near_origin = [0.0; 3];
         let mut far_origin = [0.0; 3];
         let mut inv = [1.0; 3];
         for k in 0..3 {
             // `inv_dir` is 0 where the ray is parallel to the axis's planes.
-            let d = ray.inv_dir[k];
+            let d = inv_dir[k];
             let d32 = d as f32;
             let usable = d.abs() <= MAX_INVERSE && d32 != 0.0;
             let negative = d < 0.0;
             let (up, down) = (round_up(o[k]), round_down(o[k]));
-            near_plane[k] = 2 * k + negative as usize;
-            far_plane[k] = 2 * k + 1 - negative as usize;
+            negative_axes[k] = negative;
             // Unusable: any box passes this axis ((plane - inf) * 1 = -inf
             // for the near plane, +inf for the far one).
             near_origin[k] = match (usable, negative) {
@@ -185,8 +275,7 @@ impl BoxRay {
             inv[k] = if usable { d32 } else { 1.0 };
         }
         BoxRay {
-            near_plane,
-            far_plane,
+            negative: negative_axes,
             near_origin,
             far_origin,
             inv,
@@ -198,8 +287,13 @@ impl BoxRay {
 /// parameters are.
 #[inline(always)]
 pub(super) fn limit_f32(t: f64) -> f32 {
-    if t.is_nan() {
-        return f32::INFINITY;
+    if !t.is_finite() {
+        // No limit, or (a blocked shadow lane) below everything.
+        return if t == f64::NEG_INFINITY {
+            f32::NEG_INFINITY
+        } else {
+            f32::INFINITY
+        };
     }
     round_up(t) * (1.0 + 2.0 * WIDEN)
 }
@@ -225,7 +319,7 @@ fn round_up(x: f64) -> f32 {
 
 /// Computes the boxes depth first: a leaf's is the union of its shapes'
 /// boxes clipped to its cell, an interior node's the union of its
-/// children's.
+/// children's, each written into its parent's block.
 struct Fill<'a> {
     nodes: &'a [Node],
     refs: &'a [u32],
@@ -236,6 +330,8 @@ struct Fill<'a> {
 }
 
 impl Fill<'_> {
+    /// The box of what node `index` (in `cell`) holds, its children's
+    /// boxes written into its block.
     fn node(&mut self, index: usize, cell: Cell) -> Aabb {
         let node = self.nodes[index];
         let mut held = Aabb::EMPTY;
@@ -247,22 +343,36 @@ impl Fill<'_> {
                     held = held.union(b.intersection(cell_box));
                 }
             }
-        } else {
-            for c in 0..8 {
-                if node.mask() >> c & 1 == 1 {
-                    let child = node.child(c) as usize;
-                    held = held.union(self.node(child, cell.child(c)));
-                }
-            }
+            return held;
         }
-        if !held.is_empty() {
-            let lo = held.min - self.origin;
-            let hi = held.max - self.origin;
-            for k in 0..3 {
-                self.boxes.planes[2 * k][index] = round_down(lo[k] - self.pad);
-                self.boxes.planes[2 * k + 1][index] = round_up(hi[k] + self.pad);
+        let block = self.boxes.blocks.len();
+        self.boxes.blocks.push(Block::EMPTY);
+        self.boxes.block_of[index] = block as u32;
+        let mut lane = 0;
+        for c in 0..8 {
+            if node.mask() >> c & 1 == 1 {
+                let child = node.child(c) as usize;
+                let child_held = self.node(child, cell.child(c));
+                self.set(block, lane, child_held);
+                held = held.union(child_held);
+                lane += 1;
             }
         }
         held
+    }
+
+    /// Writes `held`, padded, relative and rounded outward, into lane
+    /// `lane` of block `block` (an empty box stays empty).
+    fn set(&mut self, block: usize, lane: usize, held: Aabb) {
+        if held.is_empty() {
+            return;
+        }
+        let lo = held.min - self.origin;
+        let hi = held.max - self.origin;
+        let planes = &mut self.boxes.blocks[block].planes;
+        for k in 0..3 {
+            planes[2 * k][lane] = round_down(lo[k] - self.pad);
+            planes[2 * k + 1][lane] = round_up(hi[k] + self.pad);
+        }
     }
 }

@@ -380,7 +380,10 @@ impl Builder<'_> {
                     .sum();
                 let mask = (0..8).fold(0u32, |m, c| m | ((!children[c].is_empty() as u32) << c));
                 let stored = mask.count_ones() as u64;
-                let after = self.used - held + stored * NODE_BYTES + queued;
+                let after = self.used - held
+                    + stored * NODE_BYTES
+                    + NodeBoxes::BYTES_PER_INTERIOR_NODE
+                    + queued;
                 if after <= self.budget {
                     self.used = after;
                     let first = self.nodes.len;

@@ -16,7 +16,7 @@
 use super::node::{LEVEL_MASK, Node, child_corner};
 use super::tree::Octree;
 use super::visit::{CellEntry, CellStack, Mailbox, Visitor};
-use crate::accel::primitives::{Primitives, ShadowCrossings, test_occlusion};
+use crate::accel::primitives::Primitives;
 use crate::limits::MAX_OCTREE_DEPTH;
 use crate::shapes::{PacketHits, RayPacket};
 use crate::simd::{F64s, lanes, mask, max, min, per_axis};
@@ -63,65 +63,6 @@ impl<C: Counter, const N: usize> PacketVisitor<N> for Closest<'_, C, N> {
     }
 }
 
-struct Shadowed<'a, C, const N: usize> {
-    prims: &'a Primitives<'a>,
-    packet: &'a RayPacket<N>,
-    t_max: F64s<N>,
-    /// Lanes an opaque shape blocks; their limit drops below every cell.
-    blocked: u32,
-    /// Each lane's crossings of transparent shapes.
-    found: &'a mut [ShadowCrossings; N],
-    counter: &'a mut C,
-}
-
-impl<C: Counter, const N: usize> Visitor for Shadowed<'_, C, N> {
-    type Limit = F64s<N>;
-    type C = C;
-    #[inline(always)]
-    fn limit(&self) -> F64s<N> {
-        lanes!(N, |i| if self.blocked >> i & 1 == 1 {
-            f64::NEG_INFINITY
-        } else {
-            self.t_max[i]
-        })
-    }
-    #[inline(always)]
-    fn counter(&mut self) -> &mut C {
-        self.counter
-    }
-}
-
-impl<C: Counter, const N: usize> PacketVisitor<N> for Shadowed<'_, C, N> {
-    #[inline(always)]
-    fn test(&mut self, index: u32, lanes: u32) {
-        let lanes = lanes & !self.blocked;
-        if lanes == 0 {
-            return;
-        }
-        if self.prims.is_transparent(index) {
-            // Light passes: each lane keeps its crossings, as a single
-            // shadow ray does.
-            for i in 0..N {
-                if lanes >> i & 1 == 1 {
-                    let ray = self.packet.lane(i);
-                    test_occlusion(
-                        self.prims,
-                        index,
-                        &ray,
-                        self.t_max[i],
-                        &mut self.found[i],
-                        self.counter,
-                    );
-                }
-            }
-        } else {
-            self.blocked |=
-                self.prims
-                    .blocked_lanes(index, self.packet, &self.t_max, lanes, self.counter);
-        }
-    }
-}
-
 impl Octree {
     /// Each lane's closest hit with `0 < t < t_max[lane]`, as
     /// [`Octree::closest`] finds it for the lane's ray alone.
@@ -145,38 +86,6 @@ impl Octree {
         }
         self.walk_packet(packet, stack, &mut visitor);
         visitor.best
-    }
-
-    /// What each lane's shadow ray meets over `(0, t_max)`: the lanes an
-    /// opaque shape blocks (returned), and each other lane's crossings of
-    /// transparent shapes into `found` (cleared first), as
-    /// [`Octree::occlusion`] finds them for the lane's ray alone.
-    #[inline(always)]
-    pub fn occlusion_packet<C: Counter, const N: usize>(
-        &self,
-        prims: &Primitives,
-        packet: &RayPacket<N>,
-        t_max: F64s<N>,
-        found: &mut [ShadowCrossings; N],
-        stack: &mut PacketStack<N>,
-        counter: &mut C,
-    ) -> u32 {
-        for f in found.iter_mut() {
-            f.clear();
-        }
-        let mut visitor = Shadowed {
-            prims,
-            packet,
-            t_max,
-            blocked: 0,
-            found,
-            counter,
-        };
-        for &i in &self.unbounded {
-            visitor.test(i, packet.live);
-        }
-        self.walk_packet(packet, stack, &mut visitor);
-        visitor.blocked
     }
 
     #[inline(always)]

@@ -2,6 +2,7 @@
 //! Ureña & Lastra (2000), iteratively on a per-thread stack, for the
 //! closest hit and for shadow rays.
 
+use super::bounds::{Baseline, BoxLanes};
 use super::node::{LEVEL_MASK, child_corner};
 use super::tree::Octree;
 use super::visit::{CellEntry, CellStack, LeafVisitor, Mailbox, Visitor};
@@ -24,6 +25,21 @@ impl Octree {
         stack: &mut WalkStack,
         counter: &mut C,
     ) -> Option<ClosestHit> {
+        self.closest_inline(prims, ray, t_max, stack, counter, Baseline)
+    }
+
+    /// [`Octree::closest`], inlined into a caller compiled for a SIMD level
+    /// whose `lanes` test a node's children.
+    #[inline(always)]
+    pub fn closest_inline<C: Counter, L: BoxLanes>(
+        &self,
+        prims: &Primitives,
+        ray: &PreparedRay,
+        t_max: f64,
+        stack: &mut WalkStack,
+        counter: &mut C,
+        lanes: L,
+    ) -> Option<ClosestHit> {
         let mut visitor = ClosestVisitor {
             prims,
             ray,
@@ -36,7 +52,7 @@ impl Octree {
             test_closest(prims, i, ray, &mut visitor.best, t_max, visitor.counter);
         }
         if !C::COUNTS && self.has_boxes() {
-            self.walk_wide(ray, &mut stack.wide, &mut visitor);
+            self.walk_wide(ray, &mut stack.wide, &mut visitor, lanes);
         } else {
             let limit = visitor.limit();
             self.walk(ray, limit, stack, &mut visitor);
@@ -55,6 +71,23 @@ impl Octree {
         stack: &mut WalkStack,
         counter: &mut C,
     ) {
+        self.occlusion_inline(prims, ray, t_max, found, stack, counter, Baseline);
+    }
+
+    /// [`Octree::occlusion`], inlined into a caller compiled for a SIMD
+    /// level whose `lanes` test a node's children.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub fn occlusion_inline<C: Counter, L: BoxLanes>(
+        &self,
+        prims: &Primitives,
+        ray: &PreparedRay,
+        t_max: f64,
+        found: &mut ShadowCrossings,
+        stack: &mut WalkStack,
+        counter: &mut C,
+        lanes: L,
+    ) {
         found.clear();
         for &i in &self.unbounded {
             if test_occlusion(prims, i, ray, t_max, found, counter) {
@@ -71,7 +104,7 @@ impl Octree {
             counter,
         };
         if !C::COUNTS && self.has_boxes() {
-            self.walk_wide(ray, &mut stack.wide, &mut visitor);
+            self.walk_wide(ray, &mut stack.wide, &mut visitor, lanes);
         } else {
             self.walk(ray, t_max, stack, &mut visitor);
         }
@@ -109,7 +142,7 @@ impl Octree {
     /// The traversal: pops cells front to back until the visitor stops or
     /// nothing further along the ray can matter.
     #[inline(always)]
-    fn walk<V: LeafVisitor>(
+    pub(super) fn walk<V: LeafVisitor>(
         &self,
         ray: &PreparedRay,
         t_max: f64,

@@ -9,7 +9,7 @@
 //! `(t, shape index)` whatever the order of the tests. Havran's measures
 //! count the exact walk's cells, so a counted query takes that walk.
 
-use super::bounds::{BoxRay, limit_f32};
+use super::bounds::{BoxLanes, BoxRay, limit_f32};
 use super::tree::Octree;
 use super::visit::LeafVisitor;
 use crate::limits::MAX_OCTREE_DEPTH;
@@ -50,15 +50,16 @@ impl Octree {
     /// Visits the leaves whose boxes `ray` meets before the visitor's
     /// limit, nearest first, until the visitor says stop.
     #[inline(always)]
-    pub(super) fn walk_wide<V: LeafVisitor>(
+    pub(super) fn walk_wide<V: LeafVisitor, L: BoxLanes>(
         &self,
         ray: &PreparedRay,
         stack: &mut WideStack,
         visitor: &mut V,
+        lanes: L,
     ) {
         let boxes = &self.boxes;
         let box_ray = BoxRay::new(ray, &self.root_cell());
-        let (root, entry) = boxes.hit(0, 1, &box_ray, limit_f32(visitor.limit()));
+        let (root, entry) = lanes.hit(boxes.root(), 1, &box_ray, limit_f32(visitor.limit()));
         if root == 0 {
             return;
         }
@@ -89,8 +90,12 @@ impl Octree {
                     break;
                 }
                 let first = node.first;
-                let (mut hits, entry) =
-                    boxes.hit(first as usize, node.mask().count_ones(), &box_ray, limit);
+                let (mut hits, entry) = lanes.hit(
+                    boxes.children(index),
+                    node.mask().count_ones(),
+                    &box_ray,
+                    limit,
+                );
                 if hits == 0 {
                     break;
                 }
