@@ -19,6 +19,11 @@ from conftest import REPO, scene_path
 LONG = {"width": 640, "height": 480, "samples": 16, "octree": False}
 
 CHILD = textwrap.dedent(f"""
+    # A runner started in the background by a shell without job control
+    # has SIGINT ignored, and its children inherit that; a terminal or a
+    # notebook kernel has Python's own handler, which this puts back.
+    import signal
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     import glint
     scene = glint.load({scene_path("default.toml")!r})
     print("rendering", flush=True)
