@@ -477,7 +477,7 @@ def python_module():
     run: each repeat times the command (a process: load, octree, render,
     PNG) and then the module in a fresh interpreter (the same steps, timed
     from `glint.load` to `frame.save`, import excluded)."""
-    scene, repeats = "scenes/default.toml", 5
+    scene, repeats = "scenes/default.toml", 9
     lines = []
     with tempfile.TemporaryDirectory() as d:
         for (width, height), aa in (((800, 600), "adaptive"), ((800, 600), "off")):
