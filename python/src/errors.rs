@@ -10,7 +10,7 @@ use pyo3::prelude::*;
 use glint::scene::{EditError, SceneError as LoadError};
 
 pyo3::create_exception!(
-    _glint,
+    glint,
     SceneError,
     PyValueError,
     "A scene file that cannot be read, or an edit the scene refuses. \
@@ -18,7 +18,7 @@ pyo3::create_exception!(
 );
 
 pyo3::create_exception!(
-    _glint,
+    glint,
     Cancelled,
     pyo3::exceptions::PyException,
     "A render or benchmark stopped by its `cancel` hook."
