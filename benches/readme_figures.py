@@ -457,6 +457,53 @@ def orbit():
     )
 
 
+PYTHON_RUN = """
+import json, sys, time
+import glint
+scene_file, width, height, png = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
+start = time.perf_counter()
+scene = glint.load(scene_file)
+render_start = time.perf_counter()
+frame = scene.render(width, height)
+render_end = time.perf_counter()
+frame.save(png)
+end = time.perf_counter()
+print(json.dumps({"total_s": end - start, "render_call_s": render_end - render_start}))
+"""
+
+
+def python_module():
+    """The Python module against `glint render` for the same frames, in one
+    run: each repeat times the command (a process: load, octree, render,
+    PNG) and then the module in a fresh interpreter (the same steps, timed
+    from `glint.load` to `frame.save`, import excluded)."""
+    scene, repeats = "scenes/default.toml", 9
+    lines = []
+    with tempfile.TemporaryDirectory() as d:
+        for (width, height), aa in (((800, 600), "adaptive"), ((800, 600), "off")):
+            flags = ["--width", str(width), "--height", str(height), "--aa", aa]
+            cli, module, call = [], [], []
+            for _ in range(repeats):
+                start = time.perf_counter()
+                glint("render", scene, *flags, "-o", os.path.join(d, "cli.png"), "-q")
+                cli.append(time.perf_counter() - start)
+                # The scene's own anti-aliasing, set here as on the command line.
+                code = PYTHON_RUN.replace("scene.render(width, height)",
+                                          f"scene.render(width, height, aa={aa!r})")
+                out = run([sys.executable, "-c", code, scene, str(width), str(height),
+                           os.path.join(d, "py.png")])
+                figures = json.loads(out)
+                module.append(figures["total_s"])
+                call.append(figures["render_call_s"])
+            c, m = statistics.median(cli), statistics.median(module)
+            lines.append(
+                f"- `{scene}` at {width}x{height}, `aa={aa!r}`: `glint render` {c:.3f} s, "
+                f"the module {m:.3f} s ({100 * (m / c - 1):+.1f}%; `render()` alone "
+                f"{statistics.median(call):.3f} s); medians of {repeats}, interleaved"
+            )
+    return "\n".join(lines) + f"\n\n{stamp('python')}"
+
+
 SECTIONS = {
     "spd-table": spd_table,
     "spd-protocol": spd_protocol,
@@ -469,6 +516,7 @@ SECTIONS = {
     "prediction": prediction,
     "simd": simd,
     "orbit": orbit,
+    "python": python_module,
 }
 
 

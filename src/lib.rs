@@ -25,6 +25,7 @@ pub mod limits;
 pub mod material;
 pub mod math;
 pub mod render;
+pub mod report;
 pub mod scene;
 pub mod settings;
 pub mod shapes;

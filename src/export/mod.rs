@@ -98,6 +98,25 @@ pub fn save_frame(
     }
 }
 
+/// The record `glint render` writes for `scene` (named `scene_name` as the
+/// user gave it) seen from `camera` with `settings`. The record names the
+/// scene file by its absolute path, as the viewer's exports do, so
+/// `--from-png` finds it and its meshes from any folder (the built-in
+/// scene keeps its name; `--stats` keeps the path as given).
+pub fn render_record(
+    scene: &Scene,
+    scene_name: &str,
+    camera: &CameraSpec,
+    settings: RenderSettings,
+) -> RenderRecord {
+    let recorded_path = if scene_name == crate::scene::builtin::NAME {
+        scene_name.to_owned()
+    } else {
+        absolute_name(Path::new(scene_name))
+    };
+    RenderRecord::new(scene, &recorded_path, camera, settings)
+}
+
 /// A render restored from the record of a PNG: its scene (with the
 /// recorded octree parameters and viewer edits), settings, camera and
 /// overlay, and what the user should know about it.

@@ -3,6 +3,7 @@
 //! OBJ model also opens on its own, in a scene written around it.
 
 pub mod builtin;
+pub mod edit;
 mod file_source;
 mod keyhole;
 mod mesh;
@@ -20,6 +21,7 @@ pub mod toml_format;
 use std::path::Path;
 use std::sync::Arc;
 
+pub use edit::{EditError, KeyValue};
 pub use file_source::{FileRead, FileSource, FileSystem};
 pub use model::{ImageSettings, Location, MeshCounts, MeshMaterialOrigin, Scene, SceneError};
 pub use obj::SkippedElements;

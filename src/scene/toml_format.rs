@@ -14,7 +14,7 @@ use crate::accel::OctreeParams;
 use crate::camera::CameraSpec;
 use crate::limits::{
     INTENSITY_RANGE, IOR_RANGE, MAX_IMAGE_SIDE, MAX_RAY_DEPTH, SHININESS_RANGE, UNIT_RANGE,
-    check_color, check_range,
+    check_color, check_finite, check_finite_vec3, check_integer, check_range,
 };
 use crate::material::{Light, Material};
 use crate::math::{Aabb, DVec3};
@@ -149,25 +149,11 @@ impl Context<'_> {
     }
 
     fn finite(&self, v: &Spanned<f64>, key: &str) -> Result<f64, SceneError> {
-        let x = *v.get_ref();
-        if x.is_finite() {
-            Ok(x)
-        } else {
-            Err(self.error(v.span(), key, format!("must be a finite number, got {x}")))
-        }
+        check_finite(*v.get_ref()).map_err(|e| self.error(v.span(), key, e))
     }
 
     fn vec3(&self, v: &Vec3, key: &str) -> Result<DVec3, SceneError> {
-        let p = DVec3::from(*v.get_ref());
-        if p.is_finite() {
-            Ok(p)
-        } else {
-            Err(self.error(
-                v.span(),
-                key,
-                format!("must be three finite numbers, got {p}"),
-            ))
-        }
+        check_finite_vec3(DVec3::from(*v.get_ref())).map_err(|e| self.error(v.span(), key, e))
     }
 
     /// A colour whose components lie in `range` (surface colours in
@@ -229,20 +215,8 @@ impl Context<'_> {
     }
 
     fn integer(&self, v: &Spanned<i64>, key: &str, range: Range<i64>) -> Result<u32, SceneError> {
-        let x = *v.get_ref();
-        if range.contains(&x) {
-            Ok(x as u32)
-        } else {
-            Err(self.error(
-                v.span(),
-                key,
-                format!(
-                    "must be an integer from {} to {}, got {x}",
-                    range.start,
-                    range.end - 1
-                ),
-            ))
-        }
+        check_integer(*v.get_ref(), &(range.start..=range.end - 1))
+            .map_err(|e| self.error(v.span(), key, e))
     }
 }
 
@@ -380,7 +354,11 @@ pub fn parse(text: &str, path: &Path, files: &dyn FileSource) -> Result<Scene, S
         )?;
     }
     if let Some(v) = &file.octree.leaf_size {
-        octree_params.leaf_size = cx.integer(v, "octree.leaf_size", 1..1_000_001)?;
+        octree_params.leaf_size = cx.integer(
+            v,
+            "octree.leaf_size",
+            1..crate::limits::MAX_LEAF_SIZE as i64 + 1,
+        )?;
     }
     if let Some(v) = &file.octree.max_duplication {
         octree_params.max_duplication = cx.integer(v, "octree.max_duplication", 1..9)?;

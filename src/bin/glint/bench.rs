@@ -6,8 +6,8 @@ use std::time::Instant;
 use anyhow::{Result, bail};
 use glint::accel::{Octree, OctreeStats};
 use glint::render::{Prediction, Renderer, UnitCosts};
+use glint::report::{SceneBench, duration_text};
 use glint::settings::{Overrides, RenderSettings};
-use glint::stats::RenderCounts;
 use serde::Serialize;
 
 use crate::common::{
@@ -90,62 +90,6 @@ pub enum Format {
     Markdown,
 }
 
-/// One configuration's medians.
-#[derive(Serialize)]
-struct Timing {
-    /// Seconds for the whole image (for a row subset: scaled up, see `estimated`).
-    render_s: f64,
-    mrays_per_s: f64,
-    intersection_tests_per_ray: f64,
-    traversal_steps_per_ray: f64,
-    leaves_visited_per_ray: f64,
-    estimated: bool,
-}
-
-/// The JSON record of one scene; field names are a public interface.
-#[derive(Serialize)]
-struct SceneBench {
-    scene: String,
-    shapes: usize,
-    width: u32,
-    height: u32,
-    samples: u32,
-    max_depth: u32,
-    threads: usize,
-    /// The SIMD level the packets ran at (`glint info --simd` says why).
-    simd: glint::simd::SimdLevel,
-    repeats: u32,
-    load_s: f64,
-    build_s: f64,
-    octree_params: glint::accel::OctreeParams,
-    octree_stats: OctreeStats,
-    octree_on: Timing,
-    /// `octree_on` as predicted from the tree alone (docs/speed-and-accuracy.md,
-    /// "Predicting an octree's cost"), at `unit_costs`.
-    predicted: Prediction,
-    unit_costs: UnitCosts,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    octree_off: Option<Timing>,
-    /// Brute force time over octree time, measured on the same rays.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    speedup: Option<f64>,
-    /// Rows traced by the brute-force comparison: every n-th (1 = all).
-    compared_rows_every: u32,
-    /// Render time with work counting on over off (octree on, whole image).
-    /// Counted renders trace single rays, uncounted ones packets where the
-    /// SIMD level has them: the ratio is what `--stats` costs.
-    counting_overhead: f64,
-    /// Rays the image needs (all kinds).
-    rays_total: u64,
-    /// Rays by kind (eye rays, those that hit, shadow, reflection, refraction).
-    rays: glint::stats::RayCounts,
-    protocol: glint::settings::Protocol,
-    /// The SPD's published counts for this scene (default SPD scenes at
-    /// 512x512 under `--protocol spd` only).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    published: Option<glint::stats::published::SpdCounts>,
-}
-
 fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
     let start = Instant::now();
     let out = f();
@@ -159,7 +103,6 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         return sweep(args);
     }
     let pool = thread_pool(args.threads)?;
-    let threads = pool.current_num_threads();
     let mut results = Vec::new();
     for path in &args.scenes {
         let (mut scene, load_s) = load_scene(path)?;
@@ -174,140 +117,21 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             args.repeat
         );
 
-        let mut build_times = Vec::new();
-        let mut octree = None;
-        for _ in 0..args.repeat {
-            let (tree, s) = timed(|| pool.install(|| scene.build_octree()));
-            build_times.push(s);
-            octree = Some(tree?);
-        }
-        let Some(octree) = octree else {
-            bail!("no repeats")
+        let options = glint::report::BenchOptions {
+            repeat: args.repeat,
+            brute_force_budget: args.brute_force_budget,
+            octree_only: args.octree_only,
         };
-
-        let on = RenderSettings {
-            use_octree: true,
-            ..settings
-        };
-        let off = RenderSettings {
-            use_octree: false,
-            ..settings
-        };
-        let renderer_on = Renderer::new(&scene, &octree, on)?;
-        let renderer_off = Renderer::new(&scene, &octree, off)?;
-        let unit_costs = UnitCosts::measure(&renderer_on, &octree)?;
-
-        // One counted pass of each for the machine-independent figures.
-        let (counted_on, counted_s) = timed(|| pool.install(|| renderer_on.render(true, None).1));
-        let rays_total = counted_on.rays.total();
-        let pixels = settings.width as f64 * settings.height as f64;
-        let brute_tests = scene.shapes.len() as f64 * rays_total as f64;
-        let every =
-            ((brute_tests / args.brute_force_budget).ceil() as u32).clamp(1, settings.height);
-        let (counted_off, counted_off_s) = timed(|| {
-            (!args.octree_only).then(|| pool.install(|| renderer_off.trace_rows(every, true)))
-        });
-        // A repeat renders about what the counted passes did (plus the
-        // counted octree pass again): enough to say how long the rest takes.
-        let rows_note = if every > 1 {
-            format!(" (rows 1/{every})")
-        } else {
-            String::new()
-        };
-        say!(
-            "  counted passes: octree on {counted_s:.2} s{}; about {} left for this scene",
-            if args.octree_only {
-                String::new()
-            } else {
-                format!(", brute force {counted_off_s:.2} s{rows_note}")
-            },
-            duration_text(args.repeat as f64 * (2.0 * counted_s + counted_off_s))
-        );
-
-        // Timed passes, interleaved so drift in machine speed hits both alike.
-        let (mut full_on, mut rows_on, mut rows_off) = (Vec::new(), Vec::new(), Vec::new());
-        let mut counted_times = vec![counted_s];
-        let repeats_started = std::time::Instant::now();
-        for r in 0..args.repeat {
-            if r > 0 {
-                let per_repeat = repeats_started.elapsed().as_secs_f64() / r as f64;
-                say!(
-                    "  repeat {}/{}: about {} left for this scene",
-                    r + 1,
-                    args.repeat,
-                    duration_text(per_repeat * (args.repeat - r) as f64)
-                );
-            } else {
-                say!("  repeat 1/{}", args.repeat);
-            }
-            full_on.push(timed(|| pool.install(|| renderer_on.render(false, None))).1);
-            if r > 0 {
-                counted_times.push(timed(|| pool.install(|| renderer_on.render(true, None))).1);
-            }
-            if args.octree_only {
-                continue;
-            }
-            if every > 1 {
-                rows_on.push(timed(|| pool.install(|| renderer_on.trace_rows(every, false))).1);
-            }
-            rows_off.push(timed(|| pool.install(|| renderer_off.trace_rows(every, false))).1);
-        }
-        let on_s = median(full_on);
-        let speedup = (!args.octree_only).then(|| {
-            let on_rows_s = if every > 1 { median(rows_on) } else { on_s };
-            median(rows_off.clone()) / on_rows_s
-        });
-        let per_ray = |c: &RenderCounts, x: u64| x as f64 / c.rays.total().max(1) as f64;
-        let timing = |c: &RenderCounts, seconds: f64, rays_in_time: f64, estimated: bool| Timing {
-            render_s: seconds,
-            mrays_per_s: rays_in_time / seconds.max(1e-12) / 1e6,
-            intersection_tests_per_ray: per_ray(c, c.work.intersection_tests),
-            traversal_steps_per_ray: per_ray(c, c.work.traversal_steps),
-            leaves_visited_per_ray: per_ray(c, c.work.leaves_visited),
-            estimated,
-        };
-        let _ = pixels;
-        results.push(SceneBench {
-            scene: path.display().to_string(),
-            shapes: scene.shapes.len(),
-            width: settings.width,
-            height: settings.height,
-            samples: settings.samples,
-            max_depth: settings.max_depth,
-            threads,
-            simd: glint::simd::SimdLevel::current(),
-            repeats: args.repeat,
+        let name = path.display().to_string();
+        results.push(glint::report::bench_scene(
+            &scene,
+            &name,
             load_s,
-            build_s: median(build_times),
-            octree_params: scene.octree_params,
-            octree_stats: octree.stats(),
-            octree_on: timing(&counted_on, on_s, rays_total as f64, false),
-            predicted: unit_costs.predict(octree.predicted_cost(), rays_total, threads),
-            unit_costs,
-            // The whole-image estimate, with throughput measured on the subset.
-            octree_off: counted_off
-                .as_ref()
-                .zip(speedup)
-                .map(|(c, speedup)| Timing {
-                    render_s: on_s * speedup,
-                    ..timing(
-                        c,
-                        median(rows_off.clone()),
-                        c.rays.total() as f64,
-                        every > 1,
-                    )
-                }),
-            speedup,
-            compared_rows_every: every,
-            counting_overhead: median(counted_times) / on_s,
-            rays_total,
-            rays: counted_on.rays,
-            protocol: settings.protocol,
-            published: (settings.protocol == glint::settings::Protocol::Spd
-                && (settings.width, settings.height) == (512, 512))
-                .then(|| glint::stats::published::spd_counts(&stem(path)))
-                .flatten(),
-        });
+            settings,
+            options,
+            &pool,
+            &SayProgress,
+        )?);
     }
     match args.format {
         Format::Json => out!("{}", serde_json::to_string_pretty(&results)?)?,
@@ -319,6 +143,15 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// Progress lines on standard error; a benchmark is never stopped early.
+struct SayProgress;
+
+impl glint::report::BenchWatch for SayProgress {
+    fn say(&self, line: &str) {
+        say!("{line}");
+    }
 }
 
 /// A scene file's stem, as the published tables name the SPD scenes.
@@ -638,16 +471,4 @@ fn bench_settings(args: &BenchArgs, scene: &mut glint::scene::Scene) -> RenderSe
     let mut settings = scene.render_settings();
     overrides.apply(&mut settings, &mut scene.octree_params);
     settings
-}
-
-/// "4 min 20 s", "12 s", "0.3 s": a time left as a person reads it.
-fn duration_text(seconds: f64) -> String {
-    if seconds < 10.0 {
-        format!("{seconds:.1} s")
-    } else if seconds < 60.0 {
-        format!("{seconds:.0} s")
-    } else {
-        let whole = seconds.round() as u64;
-        format!("{} min {} s", whole / 60, whole % 60)
-    }
 }

@@ -20,17 +20,7 @@ impl Switch {
     }
 }
 
-/// The median of timings: the middle one, or the mean of the middle two
-/// (`NaN` for none).
-pub fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    match n {
-        0 => f64::NAN,
-        _ if n % 2 == 1 => v[n / 2],
-        _ => 0.5 * (v[n / 2 - 1] + v[n / 2]),
-    }
-}
+pub use glint::report::median;
 
 /// Loads a scene and reports how long it took.
 pub fn load_scene(path: &Path) -> Result<(Scene, f64)> {
@@ -70,9 +60,7 @@ pub fn shell_quoted(word: &str) -> String {
     }
 }
 
-/// Most render threads per core: more only add switching (5,000 threads
-/// made a 0.12 s render take 19.5 s).
-pub const MAX_THREADS_PER_CORE: usize = 8;
+pub use glint::limits::MAX_THREADS_PER_CORE;
 
 /// Refuses more than [`MAX_THREADS_PER_CORE`] threads per core.
 pub fn check_threads(threads: usize) -> Result<()> {

@@ -5,12 +5,10 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use glint::accel::{Octree, OctreeStats};
+use glint::accel::Octree;
 use glint::camera::CameraSpec;
 use glint::render::{FinishedTile, PassInfo, PassOptions, PassWatch, RenderedFrame, Renderer};
 use glint::settings::{Overrides, RenderSettings, ViewMode};
-use glint::stats::RayCounts;
-use serde::Serialize;
 
 use crate::common::{
     OctreeArgs, RulesArgs, Switch, load_scene, parse_pixel, parse_positive, parse_samples,
@@ -103,100 +101,6 @@ pub struct RenderArgs {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum OverlayKind {
     Octree,
-}
-
-/// The `--trace-pixel` object (schema in docs/inspection.md, "A pixel's ray tree").
-#[derive(Serialize)]
-struct TraceJson<'a> {
-    scene: String,
-    pixel: [u32; 2],
-    width: u32,
-    height: u32,
-    max_depth: u32,
-    octree: bool,
-    /// Under `spd` the tree is the pixel's top-left corner ray's.
-    protocol: glint::settings::Protocol,
-    colors: glint::color::ColorConvention,
-    /// The pixel's value at 1 sample (shading values) and as written to
-    /// PNG (encoded by the colour convention; the name is historical).
-    color: [f64; 3],
-    srgb8: [u8; 3],
-    lights: Vec<LightJson>,
-    tree: &'a glint::render::ray_tree::RayNode,
-}
-
-#[derive(Serialize)]
-struct LightJson {
-    position: [f64; 3],
-    color: [f64; 3],
-}
-
-/// The `--stats` object. Its field names are a public interface: add
-/// fields, never rename or repurpose them.
-#[derive(Serialize)]
-struct RenderStats {
-    scene: String,
-    width: u32,
-    height: u32,
-    samples: u32,
-    max_depth: u32,
-    threads: usize,
-    octree: bool,
-    octree_params: glint::accel::OctreeParams,
-    view: ViewMode,
-    protocol: glint::settings::Protocol,
-    colors: glint::color::ColorConvention,
-    sides: glint::settings::Sides,
-    aa: glint::settings::AntiAliasing,
-    /// Pixels the adaptive anti-aliasing refined with the full grid, and
-    /// their share of the image (0 unless `aa` is adaptive).
-    refined_pixels: u64,
-    refined_fraction: f64,
-    load_s: f64,
-    build_s: f64,
-    render_s: f64,
-    rays: RaysJson,
-    mrays_per_s: f64,
-    intersection_tests_per_ray: f64,
-    traversal_steps_per_ray: f64,
-    leaves_visited_per_ray: f64,
-    nonfinite_samples: u64,
-    dropped_degenerate_triangles: usize,
-    /// The shapes rendered, by kind (`triangle`, `sphere`, `plane`,
-    /// `quadric`, `cone`; kinds the scene lacks are left out).
-    shapes: std::collections::BTreeMap<&'static str, usize>,
-    /// Each mesh file: its path, triangles read, folded quads split, and
-    /// what it dropped or skipped.
-    meshes: Vec<glint::scene::MeshCounts>,
-    /// Polygons dropped at load: of zero area, or not simple.
-    dropped_polygons: glint::scene::DroppedPolygons,
-    /// OBJ elements not rendered (lines, points, short faces, other
-    /// statements), counted.
-    skipped_elements: glint::scene::SkippedElements,
-    /// MTL keys not rendered, with the number of materials using each.
-    not_rendered: std::collections::BTreeMap<String, usize>,
-    /// What loading had to say (unreadable material libraries, undefined
-    /// material names).
-    load_notes: Vec<String>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    octree_stats: Option<OctreeStats>,
-    /// With `--view cost` or `cost-steps`: the per-pixel count's range.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    cost_per_pixel: Option<CostJson>,
-}
-
-#[derive(Serialize)]
-struct CostJson {
-    min: f64,
-    max: f64,
-    mean: f64,
-}
-
-#[derive(Serialize)]
-struct RaysJson {
-    #[serde(flatten)]
-    counts: RayCounts,
-    total: u64,
 }
 
 /// A render ready to go: the scene, its octree and every setting, checked.
@@ -403,16 +307,7 @@ fn save(
     output: &std::path::Path,
 ) -> Result<()> {
     let s = &job.settings;
-    // The record names the scene file by its absolute path, as the
-    // viewer's exports do, so `--from-png` finds it and its meshes from any
-    // folder (the built-in scene keeps its name; --stats keeps the path as
-    // given).
-    let recorded_path = if job.scene_name == glint::scene::builtin::NAME {
-        job.scene_name.clone()
-    } else {
-        glint::export::absolute_name(std::path::Path::new(&job.scene_name))
-    };
-    let mut record = glint::export::RenderRecord::new(&job.scene, &recorded_path, &job.camera, *s);
+    let mut record = glint::export::render_record(&job.scene, &job.scene_name, &job.camera, *s);
     record.settings.legend = job.legend;
     let camera = glint::camera::Camera::new(&job.camera, s.width, s.height)?;
     let overlay = job
@@ -489,104 +384,39 @@ fn report(
     if !args.stats {
         return Ok(());
     }
-    let total = counts.rays.total();
-    let per_ray = |x: u64| {
-        if total > 0 {
-            x as f64 / total as f64
-        } else {
-            0.0
-        }
-    };
-    let stats = RenderStats {
-        scene: job.scene_name.clone(),
-        width: settings.width,
-        height: settings.height,
-        samples: settings.samples,
-        max_depth: settings.max_depth,
-        threads: job.threads,
-        octree: settings.use_octree,
-        octree_params: scene.octree_params,
-        view: settings.view,
-        protocol: settings.protocol,
-        colors: settings.colors,
-        sides: settings.sides,
-        aa: settings.anti_aliasing(),
-        refined_pixels: counts.refined_pixels,
-        refined_fraction: counts.refined_pixels as f64
-            / (settings.width as f64 * settings.height as f64),
+    let times = glint::report::RenderTimes {
         load_s: job.load_s,
         build_s: job.build_s,
         render_s,
-        rays: RaysJson {
-            counts: counts.rays,
-            total,
-        },
-        mrays_per_s: total as f64 / render_s.max(1e-9) / 1e6,
-        intersection_tests_per_ray: per_ray(counts.work.intersection_tests),
-        traversal_steps_per_ray: per_ray(counts.work.traversal_steps),
-        leaves_visited_per_ray: per_ray(counts.work.leaves_visited),
-        nonfinite_samples: counts.nonfinite_samples,
-        dropped_degenerate_triangles: scene.dropped_triangles,
-        shapes: scene
-            .shapes
-            .iter()
-            .fold(Default::default(), |mut by_kind, s| {
-                *by_kind.entry(s.kind().name()).or_default() += 1;
-                by_kind
-            }),
-        meshes: scene.meshes.clone(),
-        dropped_polygons: scene.dropped_polygons,
-        skipped_elements: scene.skipped_elements.clone(),
-        not_rendered: scene.not_rendered.clone(),
-        load_notes: scene.load_notes.clone(),
-        octree_stats: settings.use_octree.then(|| octree.stats()),
-        cost_per_pixel: frame.cost_summary().map(|c| CostJson {
-            min: c.min,
-            max: c.max,
-            mean: c.mean,
-        }),
     };
+    let stats = glint::report::RenderStats::new(
+        &job.scene_name,
+        scene,
+        settings,
+        job.threads,
+        octree,
+        rendered,
+        times,
+    );
     out!("{}", serde_json::to_string_pretty(&stats)?)?;
     Ok(())
 }
 
 fn print_ray_tree(job: &Prepared, x: u32, y: u32) -> Result<()> {
-    let mut settings = job.settings;
+    let settings = glint::report::trace_settings(job.settings);
     anyhow::ensure!(
         x < settings.width && y < settings.height,
-        "pixel {x},{y} is outside the {}x{} image",
-        settings.width,
-        settings.height
+        "{}",
+        glint::report::PixelOutside {
+            x,
+            y,
+            width: settings.width,
+            height: settings.height
+        }
     );
-    settings.samples = 1;
-    settings.view = ViewMode::Shaded;
     let renderer = Renderer::with_camera(&job.scene, &job.octree, settings, &job.camera)
         .with_context(|| format!("cannot render {}", job.scene_name))?;
-    let tree = renderer.ray_tree(x, y);
-    let color = glam::DVec3::from_array(tree.color);
-    let srgb8 = [color.x, color.y, color.z].map(|c| settings.colors.byte(c));
-    let out = TraceJson {
-        scene: job.scene_name.clone(),
-        pixel: [x, y],
-        width: settings.width,
-        height: settings.height,
-        max_depth: settings.max_depth,
-        octree: settings.use_octree,
-        protocol: settings.protocol,
-        colors: settings.colors,
-        color: tree.color,
-        srgb8,
-        lights: job
-            .scene
-            .lights
-            .iter()
-            .map(|l| LightJson {
-                position: l.position.to_array(),
-                color: l.color.to_array(),
-            })
-            .collect(),
-        tree: &tree,
-    };
+    let out = glint::report::TraceReport::new(&renderer, &job.scene, &job.scene_name, x, y)?;
     out!("{}", serde_json::to_string_pretty(&out)?)?;
     Ok(())
 }

@@ -1,0 +1,486 @@
+//! `glint.Scene` (native half): a loaded scene, its edits by scene-file
+//! key, and what it renders: frames, a pixel's ray tree, an octree's
+//! statistics and prediction, a benchmark.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+
+use glint::accel::{Octree, OctreeParams};
+use glint::export::SceneEdits;
+use glint::render::{PassInfo, PassOptions, PassWatch, Renderer};
+use glint::report::{RenderStats, RenderTimes, TraceReport};
+use glint::scene::{KeyValue, Scene};
+
+use crate::errors::{edit_error, octree_error, render_error};
+use crate::frame::PyFrame;
+use crate::interrupt::run_stoppable;
+use crate::options::{RenderOptions, thread_pool};
+
+/// A built octree kept for the renders after it: lights, materials and
+/// the camera change no cell, so only new parameters build another.
+#[derive(Clone)]
+struct CachedOctree {
+    params: OctreeParams,
+    tree: Arc<Octree>,
+    build_s: f64,
+}
+
+#[pyclass(name = "Scene", module = "glint._glint")]
+pub struct PyScene {
+    scene: Scene,
+    /// The path as the caller gave it: statistics name the scene by it.
+    name: String,
+    load_s: f64,
+    /// The scene file's own lights and materials: an export records the
+    /// edited ones only when they differ.
+    loaded: SceneEdits,
+    octree: Option<CachedOctree>,
+}
+
+impl PyScene {
+    pub fn new(scene: Scene, name: String, load_s: f64) -> Self {
+        let loaded = SceneEdits {
+            lights: scene.lights.clone(),
+            materials: scene.materials.clone(),
+        };
+        Self {
+            scene,
+            name,
+            load_s,
+            loaded,
+            octree: None,
+        }
+    }
+
+    /// The lights and materials as edited, if they are not the file's.
+    fn edits(&self) -> Option<SceneEdits> {
+        (self.scene.lights != self.loaded.lights || self.scene.materials != self.loaded.materials)
+            .then(|| SceneEdits {
+                lights: self.scene.lights.clone(),
+                materials: self.scene.materials.clone(),
+            })
+    }
+}
+
+/// Abandons a render once `stop` is set (asked before each tile).
+struct StopWatch<'a>(&'a AtomicBool);
+
+impl PassWatch for StopWatch<'_> {
+    fn start_tile(&self, _pass: &PassInfo) -> bool {
+        !self.0.load(Ordering::Relaxed)
+    }
+}
+
+/// Stops a benchmark between timed passes once `stop` is set.
+struct BenchStop<'a>(&'a AtomicBool);
+
+impl glint::report::BenchWatch for BenchStop<'_> {
+    fn stop(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
+}
+
+/// What a render needs from the scene object, taken in one short borrow
+/// so the GIL can be released without holding it.
+struct Snapshot {
+    scene: Scene,
+    name: String,
+    load_s: f64,
+    edits: Option<SceneEdits>,
+    cached: Option<CachedOctree>,
+}
+
+fn snapshot(slf: &Bound<'_, PyScene>) -> Snapshot {
+    let me = slf.borrow();
+    Snapshot {
+        scene: me.scene.clone(),
+        name: me.name.clone(),
+        load_s: me.load_s,
+        edits: me.edits(),
+        cached: me.octree.clone(),
+    }
+}
+
+/// The scene's octree, built with the GIL released unless the last one
+/// built has the same parameters; with the octree off, an empty one (as
+/// `glint render --octree off`). Returns it and its build's seconds.
+fn octree_for(
+    slf: &Bound<'_, PyScene>,
+    snap: &Snapshot,
+    use_octree: bool,
+    pool: &rayon::ThreadPool,
+) -> PyResult<(Arc<Octree>, f64)> {
+    let params = snap.scene.octree_params;
+    if !use_octree {
+        let empty = Octree::build(&[], params).map_err(|e| octree_error(&e))?;
+        return Ok((Arc::new(empty), 0.0));
+    }
+    if let Some(c) = snap.cached.as_ref().filter(|c| c.params == params) {
+        return Ok((c.tree.clone(), c.build_s));
+    }
+    let (tree, build_s) = slf.py().detach(|| {
+        let start = Instant::now();
+        let tree = pool.install(|| snap.scene.build_octree());
+        (tree, start.elapsed().as_secs_f64())
+    });
+    let tree = Arc::new(tree.map_err(|e| octree_error(&e))?);
+    slf.borrow_mut().octree = Some(CachedOctree {
+        params,
+        tree: tree.clone(),
+        build_s,
+    });
+    Ok((tree, build_s))
+}
+
+fn key_value(value: &Bound<'_, PyAny>) -> PyResult<KeyValue> {
+    // bool before int: Python's True is an int too.
+    if let Ok(b) = value.cast::<pyo3::types::PyBool>() {
+        return Ok(KeyValue::Switch(b.is_true()));
+    }
+    if let Ok(n) = value.cast::<pyo3::types::PyInt>() {
+        return Ok(KeyValue::Integer(n.extract()?));
+    }
+    if let Ok(x) = value.extract::<f64>() {
+        return Ok(KeyValue::Number(x));
+    }
+    value
+        .extract::<[f64; 3]>()
+        .map(KeyValue::Triple)
+        .map_err(|_| {
+            PyValueError::new_err(format!(
+                "expected a number, three numbers, a whole number or a bool, got {}",
+                value.repr().map_or_else(|_| "?".into(), |r| r.to_string())
+            ))
+        })
+}
+
+fn to_python<'py>(py: Python<'py>, value: KeyValue) -> PyResult<Bound<'py, PyAny>> {
+    Ok(match value {
+        KeyValue::Number(x) => x.into_pyobject(py)?.into_any(),
+        KeyValue::Integer(n) => n.into_pyobject(py)?.into_any(),
+        KeyValue::Switch(b) => b.into_pyobject(py)?.to_owned().into_any(),
+        KeyValue::Triple(t) => PyTuple::new(py, t)?.into_any(),
+    })
+}
+
+fn json<T: serde::Serialize>(value: &T) -> PyResult<String> {
+    serde_json::to_string(value).map_err(|e| PyRuntimeError::new_err(e.to_string()))
+}
+
+#[pymethods]
+impl PyScene {
+    /// The scene's name: its path as given to `load`.
+    #[getter]
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Seconds the scene took to load.
+    #[getter]
+    fn load_s(&self) -> f64 {
+        self.load_s
+    }
+
+    /// The value of a scene-file key (`camera.fov`, `lights[0].color`).
+    fn get<'py>(&self, py: Python<'py>, key: &str) -> PyResult<Bound<'py, PyAny>> {
+        let value = self.scene.get_key(key).map_err(|e| edit_error(py, &e))?;
+        to_python(py, value)
+    }
+
+    /// Sets a scene-file key, held to the limits scene files are held to.
+    fn set(&mut self, py: Python<'_>, key: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        let value = key_value(value)?;
+        self.scene
+            .set_key(key, value)
+            .map_err(|e| edit_error(py, &e))
+    }
+
+    /// Every key `get` reads, in scene-file order.
+    fn keys(&self) -> Vec<String> {
+        self.scene.keys()
+    }
+
+    fn light_count(&self) -> usize {
+        self.scene.lights.len()
+    }
+
+    fn material_names(&self) -> Vec<String> {
+        self.scene
+            .materials
+            .iter()
+            .map(|m| m.name.clone())
+            .collect()
+    }
+
+    /// What loading dropped, skipped or could not read, one sentence each.
+    fn notes(&self) -> Vec<String> {
+        self.scene.notes()
+    }
+
+    /// Shapes by kind, e.g. `[("sphere", 3), ("triangle", 12)]`.
+    fn shape_counts(&self) -> Vec<(&'static str, usize)> {
+        self.scene.shape_counts()
+    }
+
+    /// An independent copy: its edits do not reach this scene.
+    fn copy(&self) -> Self {
+        Self {
+            scene: self.scene.clone(),
+            name: self.name.clone(),
+            load_s: self.load_s,
+            loaded: self.loaded.clone(),
+            octree: self.octree.clone(),
+        }
+    }
+
+    #[pyo3(signature = (width=None, height=None, samples=None, aa=None, octree=None,
+        max_depth=None, view=None, threads=None, stats=false, protocol=None, colors=None,
+        sides=None, cancel=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn render(
+        slf: &Bound<'_, Self>,
+        width: Option<u32>,
+        height: Option<u32>,
+        samples: Option<u32>,
+        aa: Option<&str>,
+        octree: Option<bool>,
+        max_depth: Option<u32>,
+        view: Option<&str>,
+        threads: Option<usize>,
+        stats: bool,
+        protocol: Option<&str>,
+        colors: Option<&str>,
+        sides: Option<&str>,
+        cancel: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<PyFrame> {
+        let py = slf.py();
+        let snap = snapshot(slf);
+        let options = RenderOptions {
+            width,
+            height,
+            samples,
+            aa,
+            octree,
+            max_depth,
+            view,
+            protocol,
+            colors,
+            sides,
+        };
+        let settings = options.settings(&snap.scene)?;
+        let pool = thread_pool(threads)?;
+        let (tree, build_s) = octree_for(slf, &snap, settings.use_octree, &pool)?;
+        let renderer = Renderer::with_camera(&snap.scene, &tree, settings, &snap.scene.camera)
+            .map_err(|e| render_error(&e))?;
+        glint::render::memory::check_memory(&settings, tree.stats().memory_bytes)
+            .map_err(|e| render_error(&e))?;
+        let stop = AtomicBool::new(false);
+        let pass_options = PassOptions {
+            count_work: stats,
+            progressive: false,
+        };
+        let (rendered, render_s) = run_stoppable(py, cancel, &stop, || {
+            let start = Instant::now();
+            let rendered = pool.install(|| renderer.render_frame(pass_options, &StopWatch(&stop)));
+            (rendered, start.elapsed().as_secs_f64())
+        })?;
+        let rendered =
+            rendered.ok_or_else(|| PyRuntimeError::new_err("the render was abandoned"))?;
+        let stats_json = if stats {
+            let times = RenderTimes {
+                load_s: snap.load_s,
+                build_s,
+                render_s,
+            };
+            let threads = pool.current_num_threads();
+            let report = RenderStats::new(
+                &snap.name,
+                &snap.scene,
+                &settings,
+                threads,
+                &tree,
+                &rendered,
+                times,
+            );
+            Some(json(&report)?)
+        } else {
+            None
+        };
+        Ok(PyFrame::new(
+            rendered.frame,
+            settings,
+            snap.scene,
+            snap.name,
+            snap.edits,
+            stats_json,
+        ))
+    }
+
+    /// The `--trace-pixel` JSON of pixel (x, y) of the image these
+    /// settings make.
+    #[pyo3(signature = (x, y, width=None, height=None, octree=None, max_depth=None,
+        protocol=None, colors=None, sides=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn trace_pixel(
+        slf: &Bound<'_, Self>,
+        x: u32,
+        y: u32,
+        width: Option<u32>,
+        height: Option<u32>,
+        octree: Option<bool>,
+        max_depth: Option<u32>,
+        protocol: Option<&str>,
+        colors: Option<&str>,
+        sides: Option<&str>,
+    ) -> PyResult<String> {
+        let snap = snapshot(slf);
+        let options = RenderOptions {
+            width,
+            height,
+            octree,
+            max_depth,
+            protocol,
+            colors,
+            sides,
+            ..RenderOptions::default()
+        };
+        let settings = glint::report::trace_settings(options.settings(&snap.scene)?);
+        let pool = thread_pool(None)?;
+        let (tree, _) = octree_for(slf, &snap, settings.use_octree, &pool)?;
+        let renderer = Renderer::with_camera(&snap.scene, &tree, settings, &snap.scene.camera)
+            .map_err(|e| render_error(&e))?;
+        let report = TraceReport::new(&renderer, &snap.scene, &snap.name, x, y)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        json(&report)
+    }
+
+    /// Builds the octree with these parameters (the scene's where not
+    /// given; the scene keeps its own) and returns the JSON of its
+    /// parameters, statistics, build time and predicted cost per ray.
+    #[pyo3(signature = (max_depth=None, leaf_size=None, cost_driven=None, max_duplication=None,
+        memory_budget_mib=None, threads=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn octree(
+        &self,
+        py: Python<'_>,
+        max_depth: Option<i64>,
+        leaf_size: Option<i64>,
+        cost_driven: Option<bool>,
+        max_duplication: Option<i64>,
+        memory_budget_mib: Option<i64>,
+        threads: Option<usize>,
+    ) -> PyResult<String> {
+        // Through the scene's own keys, so the limits and messages are a
+        // scene file's.
+        let mut scene = self.scene.clone();
+        let integers = [
+            ("octree.max_depth", max_depth),
+            ("octree.leaf_size", leaf_size),
+            ("octree.max_duplication", max_duplication),
+            ("octree.memory_budget_mib", memory_budget_mib),
+        ];
+        for (key, value) in integers {
+            if let Some(n) = value {
+                scene
+                    .set_key(key, KeyValue::Integer(n))
+                    .map_err(|e| edit_error(py, &e))?;
+            }
+        }
+        if let Some(c) = cost_driven {
+            scene.octree_params.cost_driven = c;
+        }
+        let pool = thread_pool(threads)?;
+        let (tree, build_s) = py.detach(|| {
+            let start = Instant::now();
+            let tree = pool.install(|| scene.build_octree());
+            (tree, start.elapsed().as_secs_f64())
+        });
+        let tree = tree.map_err(|e| octree_error(&e))?;
+        json(&serde_json::json!({
+            "octree_params": scene.octree_params,
+            "octree_stats": tree.stats(),
+            "build_s": build_s,
+            "predicted": tree.predicted_cost(),
+        }))
+    }
+
+    /// The `glint bench --format json` record of this scene.
+    #[pyo3(signature = (width=None, height=None, samples=None, aa=None, max_depth=None,
+        view=None, protocol=None, colors=None, sides=None, repeat=3, threads=None,
+        octree_only=false, brute_force_budget=4e9, cancel=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn bench(
+        slf: &Bound<'_, Self>,
+        width: Option<u32>,
+        height: Option<u32>,
+        samples: Option<u32>,
+        aa: Option<&str>,
+        max_depth: Option<u32>,
+        view: Option<&str>,
+        protocol: Option<&str>,
+        colors: Option<&str>,
+        sides: Option<&str>,
+        repeat: u32,
+        threads: Option<usize>,
+        octree_only: bool,
+        brute_force_budget: f64,
+        cancel: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<String> {
+        if repeat == 0 {
+            return Err(PyValueError::new_err("repeat must be at least 1"));
+        }
+        let snap = snapshot(slf);
+        let options = RenderOptions {
+            width,
+            height,
+            samples,
+            aa,
+            max_depth,
+            view,
+            protocol,
+            colors,
+            sides,
+            ..RenderOptions::default()
+        };
+        let settings = options.settings(&snap.scene)?;
+        let pool = thread_pool(threads)?;
+        let bench = glint::report::BenchOptions {
+            repeat,
+            brute_force_budget,
+            octree_only,
+        };
+        let stop = AtomicBool::new(false);
+        let result = run_stoppable(slf.py(), cancel, &stop, || {
+            glint::report::bench_scene(
+                &snap.scene,
+                &snap.name,
+                snap.load_s,
+                settings,
+                bench,
+                &pool,
+                &BenchStop(&stop),
+            )
+        })?;
+        match result {
+            Ok(record) => json(&record),
+            Err(glint::report::BenchError::Render(e)) => Err(render_error(&e)),
+            Err(glint::report::BenchError::Octree(e)) => Err(octree_error(&e)),
+            Err(e) => Err(PyRuntimeError::new_err(e.to_string())),
+        }
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<glint.Scene {}: {} shapes, {} lights, {} materials>",
+            self.name,
+            self.scene.shapes.len(),
+            self.scene.lights.len(),
+            self.scene.materials.len()
+        )
+    }
+}
