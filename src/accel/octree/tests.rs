@@ -348,3 +348,40 @@ fn a_build_refuses_parameters_past_the_limits() {
         )))
     );
 }
+
+#[test]
+fn a_small_model_far_from_the_origin_gets_the_tree_it_gets_at_the_origin() {
+    // Small triangles 4 mm apart, as a scan in survey coordinates: 5e6 m
+    // out, a padding relative to the coordinates (5 mm) dwarfed the deep
+    // cells and every triangle was referenced by hundreds of them.
+    let model = |offset: f64| -> Vec<Shape> {
+        let mut shapes = Vec::new();
+        for i in 0..20 {
+            for j in 0..20 {
+                let a = DVec3::new(i as f64, j as f64, (i * j % 7) as f64) * 4e-3
+                    + DVec3::splat(offset);
+                let (b, c) = (
+                    a + DVec3::new(3e-3, 0.0, 1e-3),
+                    a + DVec3::new(0.0, 3e-3, 2e-3),
+                );
+                if let Some(t) = crate::shapes::Triangle::new([a, b, c]) {
+                    shapes.push(Shape::Triangle(t));
+                }
+            }
+        }
+        shapes
+    };
+    let near = Octree::build(&model(0.0), OctreeParams::default())
+        .unwrap()
+        .stats();
+    let far = Octree::build(&model(5e6), OctreeParams::default())
+        .unwrap()
+        .stats();
+    assert!(
+        far.references <= 2 * near.references,
+        "{} references far out against {} at the origin",
+        far.references,
+        near.references
+    );
+    assert_eq!(far.leaves_stopped_by_budget, 0);
+}
