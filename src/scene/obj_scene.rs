@@ -5,9 +5,11 @@
 
 use std::path::Path;
 
-use crate::camera::CameraSpec;
+use crate::accel::{Octree, OctreeParams, Primitives, WalkStack};
+use crate::camera::{Camera, CameraSpec};
 use crate::math::{Aabb, DVec3};
-use crate::shapes::Shape;
+use crate::shapes::{PreparedRay, Shape};
+use crate::stats::NoCounts;
 
 use super::file_source::FileSource;
 use super::model::{Scene, SceneError};
@@ -82,12 +84,32 @@ pub(super) fn load(path: &Path, files: &dyn FileSource) -> Result<Scene, SceneEr
     })?;
     let bounds = scene.geometry_bounds();
     let axes = model_axes(&scene.shapes, bounds);
-    let (camera, light) = frame(bounds, axes).ok_or_else(|| SceneError::Model {
+    // A model with no faces (only lines or points): the unit box.
+    let bounds = if bounds.is_empty() {
+        Aabb::new(DVec3::splat(-1.0), DVec3::splat(1.0))
+    } else {
+        bounds
+    };
+    let too_large = || SceneError::Model {
         path: path.to_owned(),
         message: "the model's coordinates are too large to frame with a camera \
                   (the camera's distance from it would overflow a double)"
             .into(),
-    })?;
+    };
+    let direction = view_direction(bounds.max - bounds.min, axes);
+    let (mut camera, mut light) = frame(bounds, axes, direction).ok_or_else(too_large)?;
+    // The same view from the opposite side, when it shows clearly more of
+    // the model: its features rather than a flat back, the inside of a box
+    // open on that side, a face rather than the back of a head.
+    let mirrored = direction
+        - 2.0 * direction.dot(axes.front.abs()) * axes.front.abs()
+        - 2.0 * direction.dot(axes.side.abs()) * axes.side.abs();
+    if let Some((other_camera, other_light)) = frame(bounds, axes, mirrored)
+        && let Some(seen) = StructureSeen::new(&scene.shapes, &scene.vertex_normals)
+        && seen.of(&other_camera) > seen.of(&camera) * 5 / 4 + 1
+    {
+        (camera, light) = (other_camera, other_light);
+    }
     let text = wrapper_text(path, &camera, light);
     scene.camera = camera;
     if let Some(l) = scene.lights.first_mut() {
@@ -170,18 +192,12 @@ fn model_axes(shapes: &[Shape], bounds: Aabb) -> ModelAxes {
 }
 
 /// A camera that frames `bounds` and a light over its shoulder, seen from
-/// the model's broad side a little from above (`view_direction`), with the
-/// up axis the model suggests (`model_axes`). Far enough that the bounding
+/// `direction` (`view_direction`: the model's broad side a little from
+/// above), with the up axis the model suggests (`model_axes`). Far enough that the bounding
 /// sphere fits the view. `None` if that place is not a finite number (a
 /// model reaching 1e300), or so far that the camera's own length
 /// computations overflow (a model 1e154 across).
-fn frame(bounds: Aabb, axes: ModelAxes) -> Option<(CameraSpec, DVec3)> {
-    // A model with no faces (only lines or points): the unit box.
-    let bounds = if bounds.is_empty() {
-        Aabb::new(DVec3::splat(-1.0), DVec3::splat(1.0))
-    } else {
-        bounds
-    };
+fn frame(bounds: Aabb, axes: ModelAxes, direction: DVec3) -> Option<(CameraSpec, DVec3)> {
     // Halves first: min + max overflows for a model spanning 1e308.
     let center = 0.5 * bounds.min + 0.5 * bounds.max;
     let extent = bounds.max - bounds.min;
@@ -195,7 +211,6 @@ fn frame(bounds: Aabb, axes: ModelAxes) -> Option<(CameraSpec, DVec3)> {
     // A point model, or one far smaller than its distance from the origin,
     // still needs an eye apart from the lookat point.
     let radius = radius.max(center.abs().max_element() * 1e-9).max(1e-150);
-    let direction = view_direction(extent, axes);
     let distance = radius / (0.5 * FOV.to_radians()).sin() * 1.05;
     let camera = CameraSpec {
         eye: center + direction * distance,
@@ -238,6 +253,82 @@ fn view_direction(extent: DVec3, axes: ModelAxes) -> DVec3 {
         axes.front + off_square(front) * (0.35 * axes.side + 0.3 * axes.up)
     };
     direction.normalize()
+}
+
+/// How much of a model's structure a view shows: the number of distinct
+/// directions (to a fifth of a radian or so) the surfaces seen in a 32x32
+/// thumbnail face. A flat face, the closed back of a box or the back of a
+/// head shows few; a model's features, the inside of a box, many. The
+/// thumbnail's rays take a shallow octree of their own (no deeper than 6
+/// levels, a fraction of the render's build).
+struct StructureSeen<'a> {
+    shapes: &'a [Shape],
+    vertex_normals: &'a [[DVec3; 3]],
+    octree: Octree,
+}
+
+impl<'a> StructureSeen<'a> {
+    const SIDE: u32 = 32;
+    /// Models with more shapes than this keep the conventional side: the
+    /// thumbnails' octree would cost a noticeable part of the load.
+    const MAX_SHAPES: usize = 200_000;
+
+    fn new(shapes: &'a [Shape], vertex_normals: &'a [[DVec3; 3]]) -> Option<Self> {
+        if shapes.len() > Self::MAX_SHAPES {
+            return None;
+        }
+        let params = OctreeParams {
+            max_depth: 6,
+            ..OctreeParams::default()
+        };
+        let octree = Octree::build(shapes, params).ok()?;
+        Some(Self {
+            shapes,
+            vertex_normals,
+            octree,
+        })
+    }
+
+    /// The distinct facing directions seen from `camera`.
+    fn of(&self, camera: &CameraSpec) -> u32 {
+        let Ok(camera) = Camera::new(camera, Self::SIDE, Self::SIDE) else {
+            return 0;
+        };
+        let prims = Primitives::opaque(self.shapes);
+        let mut stack = WalkStack::default();
+        // 5 steps per component: 125 bins of directions.
+        let mut seen = [false; 125];
+        for j in 0..Self::SIDE {
+            for i in 0..Self::SIDE {
+                let ray = camera.ray(i, j, 0.5, 0.5);
+                let prepared = PreparedRay::new(ray);
+                let Some(hit) = self.octree.closest(
+                    &prims,
+                    &prepared,
+                    f64::INFINITY,
+                    &mut stack,
+                    &mut NoCounts,
+                ) else {
+                    continue;
+                };
+                let shape = &self.shapes[hit.shape as usize];
+                let normal = shape
+                    .surface(&ray, &hit.hit, self.vertex_normals)
+                    .geometric_normal;
+                let facing = if normal.dot(ray.dir) < 0.0 {
+                    normal
+                } else {
+                    -normal
+                };
+                if !facing.is_finite() {
+                    continue;
+                }
+                let bin = |x: f64| ((x + 1.0) * 2.0).round().clamp(0.0, 4.0) as usize;
+                seen[bin(facing.x) + 5 * bin(facing.y) + 25 * bin(facing.z)] = true;
+            }
+        }
+        seen.iter().filter(|&&s| s).count() as u32
+    }
 }
 
 /// Parses `text`, the TOML an OBJ file `path` was opened with (an
@@ -313,7 +404,9 @@ mod tests {
         // Bounds the camera would have to stand beyond the largest double
         // to see (no triangle reaches them: a face this size overflows its
         // area and is dropped at load).
-        assert!(frame(Aabb::new(DVec3::ZERO, DVec3::splat(1.5e308)), Y_UP).is_none());
+        let huge = Aabb::new(DVec3::ZERO, DVec3::splat(1.5e308));
+        let direction = view_direction(huge.max - huge.min, Y_UP);
+        assert!(frame(huge, Y_UP, direction).is_none());
         // A face 1e154 across keeps a finite area, but a camera that sees
         // it stands where eye - lookat has no finite length: refused with
         // the reason, not written as a scene that cannot load again (found
@@ -456,5 +549,26 @@ mod tests {
         let sheet = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3 4\n".to_string();
         let camera = framed(sheet);
         assert_eq!((camera.eye - camera.lookat).normalize(), DVec3::Z);
+    }
+
+    /// A model seen better from behind is seen from behind: a room open on
+    /// its back (a Cornell box) with a pyramid inside shows the pyramid
+    /// from the open side; open at the front, the conventional side
+    /// already shows it. Closed, the room keeps the front (the other side
+    /// shows no more of it).
+    #[test]
+    fn the_camera_takes_the_side_that_shows_more_of_the_model() {
+        let size = DVec3::new(2.0, 1.5, 1.0);
+        let pyramid = "v 1 0 0.2\nv 1.4 0 0.5\nv 1 0 0.8\nv 0.6 0 0.5\nv 1 1 0.5\n\
+                       f 1 2 5\nf 2 3 5\nf 3 4 5\nf 4 1 5\n";
+        let room = |omit: &[&str]| framed(with(box_obj(DVec3::ZERO, size, omit), pyramid));
+        let open_back = room(&["-z"]);
+        assert!(open_back.eye.z < open_back.lookat.z, "{open_back:?}");
+        let open_front = room(&["+z"]);
+        assert!(open_front.eye.z > open_front.lookat.z, "{open_front:?}");
+        let closed = room(&[]);
+        assert!(closed.eye.z > closed.lookat.z, "{closed:?}");
+        // The up axis stays the model's either way.
+        assert_eq!(open_back.up, DVec3::Y);
     }
 }

@@ -139,7 +139,7 @@ impl NodeBoxes {
 /// for a SIMD level. Each answers the same (see [`BoxLanes::hit`]).
 pub trait BoxLanes: Copy {
     /// The lanes `0 .. count` (at most eight) of `block` whose box `ray`
-    /// may meet before `limit` (from [`limit_f32`]), and where it
+    /// may meet before `limit` (from `limit_f32`), and where it
     /// may enter each (not before 0): never a lane it does meet, nor a
     /// later entry.
     ///
