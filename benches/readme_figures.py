@@ -177,16 +177,19 @@ def peers():
     return f"{table}\n\n{stamp('peers')}"
 
 
-def instructions(args, width, height):
+def instructions(args, width, height, env=None):
     """Instructions per ray: cachegrind at the working size minus the same
-    at 1x1 (loading and the octree build), over the render's rays."""
+    at 1x1 (loading and the octree build), over the render's rays. `env`
+    adds environment variables (GLINT_PACKETS=off: every ray single)."""
+    env = {**os.environ, "GLINT_SIMD": "avx2", **(env or {})}
+
     def count(w, h):
         with tempfile.TemporaryDirectory() as d:
             out = os.path.join(d, "cg.out")
             run(["valgrind", "--tool=cachegrind", "--cache-sim=no", f"--cachegrind-out-file={out}",
                  GLINT, "render", *args, "-o", os.path.join(d, "x.png"), "--width", str(w),
                  "--height", str(h), "--threads", "1", "-q"],
-                env={**os.environ, "GLINT_SIMD": "avx2"}, stderr=subprocess.DEVNULL)
+                env=env, stderr=subprocess.DEVNULL)
             with open(out) as f:
                 for line in f:
                     if line.startswith("summary:"):
@@ -224,7 +227,31 @@ def kernels():
         now = instructions(args, w, h)
         before = KERNEL_HISTORY[name]
         lines.append(f"| {name} | {before[0]:,} | {before[1]:,} | {before[2]:,} | {before[3]:,} | {now:,.0f} |")
+    lines += [
+        "",
+        "| single and secondary rays (issue 37) | before the wide walk | now |",
+        "|---|---:|---:|",
+    ]
+    for name, args, w, h, env in SINGLE_RAY_WORKLOADS:
+        now = instructions(args, w, h, env)
+        lines.append(f"| {name} | {SINGLE_RAY_HISTORY[name]:,} | {now:,.0f} |")
     return "\n".join(lines) + f"\n\n{stamp('kernels')}"
+
+
+# Workloads that live on single rays (shadow rays, glass and mirrors), with
+# instructions per ray measured before issue 37's wide walk (history).
+SINGLE_RAY_WORKLOADS = [
+    ("bunny primary rays, every ray single (`GLINT_PACKETS=off`), 256x192",
+     ["scenes/bunny.toml", "--view", "normals", "--samples", "1"], 256, 192,
+     {"GLINT_PACKETS": "off"}),
+    ("SPD gears, 1 spp, 128x128", ["scenes/spd/gears.nff", "--samples", "1"], 128, 128, None),
+    ("SPD rings, 1 spp, 128x128", ["scenes/spd/rings.nff", "--samples", "1"], 128, 128, None),
+]
+SINGLE_RAY_HISTORY = {
+    "bunny primary rays, every ray single (`GLINT_PACKETS=off`), 256x192": 1799,
+    "SPD gears, 1 spp, 128x128": 4054,
+    "SPD rings, 1 spp, 128x128": 4444,
+}
 
 
 def png_rgb(path):

@@ -116,7 +116,7 @@ def test_views_read_what_the_keys_hold():
     assert sorted(scene.materials) == ["clay", "floor", "glass", "gold", "mirror", "teal", "violet"]
     assert scene.materials["glass"].as_dict()["ior"] == scene.get("materials.glass.ior")
     assert scene.octree_params.as_dict() == {
-        "enabled": True, "max_depth": 10, "leaf_size": 4, "cost_driven": False,
+        "enabled": True, "max_depth": 10, "leaf_size": 4, "cost_driven": True,
         "max_duplication": 8, "memory_budget_mib": 128}
     assert "materials.glass.ior" in scene.keys()
     copy = scene.copy()
