@@ -337,7 +337,7 @@ fn report(
         let (mut width, mut height) = (frame.width, frame.height);
         let written = match glint::export::OutputTarget::resolve(output)? {
             glint::export::OutputTarget::File(p) => {
-                if let Ok((w, h)) = image::image_dimensions(&p) {
+                if let Some((w, h)) = png_size(&p) {
                     (width, height) = (w, h);
                 }
                 std::fs::metadata(&p)
@@ -419,4 +419,13 @@ fn print_ray_tree(job: &Prepared, x: u32, y: u32) -> Result<()> {
     let out = glint::report::TraceReport::new(&renderer, &job.scene, &job.scene_name, x, y)?;
     out!("{}", serde_json::to_string_pretty(&out)?)?;
     Ok(())
+}
+
+/// The width and height in a PNG's header, read without decoding pixels.
+fn png_size(path: &std::path::Path) -> Option<(u32, u32)> {
+    let file = std::fs::File::open(path).ok()?;
+    let reader = png::Decoder::new(std::io::BufReader::new(file))
+        .read_info()
+        .ok()?;
+    Some((reader.info().width, reader.info().height))
 }
