@@ -27,8 +27,8 @@ pub use passes::{
 };
 pub use renderer::{RenderError, Renderer};
 pub use unit_costs::{
-    OctreeCandidate, Prediction, SUGGESTION_DEPTHS, SUGGESTION_LEAF_SIZES, UnitCosts, random_lines,
-    suggest_octree,
+    OctreeCandidate, Prediction, RAY_SAMPLE_SIDE, RaySample, SUGGESTION_DEPTHS,
+    SUGGESTION_LEAF_SIZES, UnitCosts, random_lines, sample_rays, suggest_octree,
 };
 
 #[cfg(test)]

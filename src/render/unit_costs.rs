@@ -1,8 +1,9 @@
 //! What one traversal step, one intersection test and the rest of a ray
 //! (its generation and shading) cost on this machine, measured on the
-//! scene itself: with them, an octree's [predicted
-//! cost](crate::accel::Octree::predicted_cost) becomes a predicted render
-//! time, before the render.
+//! scene itself: with them, an octree's predicted work per ray becomes a
+//! predicted render time, before the render. The work per ray comes from
+//! the tree alone ([`Octree::predicted_cost`], the surface-area model) or
+//! from a sample of the render's own rays ([`sample_rays`]).
 
 use std::time::Instant;
 
@@ -89,14 +90,7 @@ impl UnitCosts {
             / walked.traversal_steps.max(1) as f64;
 
         // A thumbnail of the render, one thread, for what else a ray costs.
-        let mut settings = renderer.settings;
-        let scale = (48.0 / settings.width.max(settings.height) as f64).min(1.0);
-        settings.width = ((settings.width as f64 * scale).round() as u32).max(1);
-        settings.height = ((settings.height as f64 * scale).round() as u32).max(1);
-        settings.samples = 1;
-        settings.adaptive = false;
-        let thumbnail =
-            Renderer::with_camera(renderer.scene, octree, settings, &renderer.camera_spec)?;
+        let thumbnail = thumbnail(renderer, octree, 48)?;
         let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build();
         let mut counts = Default::default();
         let render_s = fastest_of_3(|| {
@@ -131,6 +125,90 @@ impl UnitCosts {
             render_s: rays as f64 * per_ray_ns * 1e-9 / threads.max(1) as f64,
         }
     }
+}
+
+/// The render `renderer` would make, at most `side` pixels on its longer
+/// side and one sample per pixel, through `octree`.
+fn thumbnail<'a>(
+    renderer: &Renderer<'a>,
+    octree: &'a Octree,
+    side: u32,
+) -> Result<Renderer<'a>, RenderError> {
+    let mut settings = renderer.settings;
+    let scale = (side as f64 / settings.width.max(settings.height) as f64).min(1.0);
+    settings.width = ((settings.width as f64 * scale).round() as u32).max(1);
+    settings.height = ((settings.height as f64 * scale).round() as u32).max(1);
+    settings.samples = 1;
+    settings.adaptive = false;
+    settings.use_octree = true;
+    Renderer::with_camera(renderer.scene, octree, settings, &renderer.camera_spec)
+}
+
+/// The longer side of the image [`sample_rays`] traces: 64 x 48 eye rays
+/// on a 4:3 view, with their shadow and secondary rays.
+pub const RAY_SAMPLE_SIDE: u32 = 64;
+
+/// What a sample of the render's own rays does and costs through one tree.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct RaySample {
+    /// Rays in the sample: eye, shadow and secondary.
+    pub rays: u64,
+    pub traversal_steps_per_ray: f64,
+    pub intersection_tests_per_ray: f64,
+    /// The sample rendered as the render runs (packets where the SIMD
+    /// level has them, no counting), on one thread, the fastest of three.
+    pub seconds_per_ray: f64,
+}
+
+impl RaySample {
+    /// The work per ray alone.
+    pub fn cost(&self) -> PredictedCost {
+        PredictedCost {
+            traversal_steps_per_ray: self.traversal_steps_per_ray,
+            intersection_tests_per_ray: self.intersection_tests_per_ray,
+        }
+    }
+
+    /// A render of `rays` rays on `threads` threads (taken as scaling
+    /// perfectly), at the sample's time per ray.
+    pub fn predict(&self, rays: u64, threads: usize) -> Prediction {
+        Prediction {
+            traversal_steps_per_ray: self.traversal_steps_per_ray,
+            intersection_tests_per_ray: self.intersection_tests_per_ray,
+            render_s: rays as f64 * self.seconds_per_ray / threads.max(1) as f64,
+        }
+    }
+}
+
+/// A sample of the render's own rays through `octree`: the render
+/// `renderer` would make, at most [`RAY_SAMPLE_SIDE`] pixels a side and one
+/// sample per pixel, traced once with the walk's counters (the work per
+/// ray) and timed as the render runs. Unlike the surface-area model it
+/// sees what the view does: rays that stop at their first hit, that miss
+/// the scene's box, that gather on the small part of the scene in view,
+/// shadow rays that stop at the first blocker, the mailbox, and what
+/// shading and packets cost on this machine. The pixel grid is coarser
+/// than the render's, so edges weigh a little more. The counts are the
+/// same on any number of threads; the time is taken on one.
+pub fn sample_rays(renderer: &Renderer, octree: &Octree) -> Result<RaySample, RenderError> {
+    let thumbnail = thumbnail(renderer, octree, RAY_SAMPLE_SIDE)?;
+    let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build();
+    let on_one_thread = |counted: bool| match &one_thread {
+        Ok(pool) => pool.install(|| thumbnail.render(counted, None).1),
+        Err(_) => thumbnail.render(counted, None).1,
+    };
+    let counts = on_one_thread(true);
+    let seconds = fastest_of_3(|| {
+        on_one_thread(false);
+    });
+    let rays = counts.rays.total();
+    let per_ray = |x: u64| x as f64 / rays.max(1) as f64;
+    Ok(RaySample {
+        rays,
+        traversal_steps_per_ray: per_ray(counts.work.traversal_steps),
+        intersection_tests_per_ray: per_ray(counts.work.intersection_tests),
+        seconds_per_ray: seconds / rays.max(1) as f64,
+    })
 }
 
 fn positive(x: f64) -> f64 {
@@ -184,18 +262,23 @@ pub fn random_lines(bounds: Aabb, count: usize) -> Vec<Ray> {
 }
 
 /// One octree setting tried for a suggestion: its build, timed, and its
-/// render, predicted.
+/// render, predicted from the tree alone and from a sample of the render's
+/// rays.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct OctreeCandidate {
     pub params: OctreeParams,
     pub build_s: f64,
     pub predicted: Prediction,
+    pub predicted_from_rays: Prediction,
 }
 
 impl OctreeCandidate {
-    /// What the suggestion minimises.
+    /// What the suggestion minimises: the build and the render predicted
+    /// from the sample of rays (docs/speed-and-accuracy.md, "Predicting an
+    /// octree's cost": it ranks settings across scenes, where the tree
+    /// alone ranks them only within one).
     pub fn predicted_total_s(&self) -> f64 {
-        self.build_s + self.predicted.render_s
+        self.build_s + self.predicted_from_rays.render_s
     }
 }
 
@@ -205,17 +288,18 @@ pub const SUGGESTION_DEPTHS: [u32; 5] = [4, 6, 8, 10, 12];
 pub const SUGGESTION_LEAF_SIZES: [u32; 5] = [1, 2, 4, 8, 16];
 
 /// Builds the octree at every setting of the suggestion grid and predicts
-/// its render of `rays` rays: every candidate, and the index of the one
-/// with the least build plus predicted render time. Renders nothing.
+/// the render `renderer` makes (`rays` rays): every candidate, and the
+/// index of the one with the least build plus predicted render time. Of
+/// the render it traces only [`sample_rays`]'s thumbnail per candidate.
 /// `keep_going` is asked between builds (the viewer cancels through it).
 pub fn suggest_octree(
-    shapes: &[Shape],
-    base: OctreeParams,
+    renderer: &Renderer,
     costs: &UnitCosts,
     rays: u64,
     threads: usize,
     keep_going: &dyn Fn() -> bool,
 ) -> Option<(Vec<OctreeCandidate>, usize)> {
+    let base = renderer.scene.octree_params;
     let mut candidates = Vec::new();
     for max_depth in SUGGESTION_DEPTHS {
         for leaf_size in SUGGESTION_LEAF_SIZES {
@@ -229,13 +313,18 @@ pub fn suggest_octree(
             };
             let start = Instant::now();
             // Over the budget a build is refused: not a candidate.
-            let Ok(octree) = Octree::build(shapes, params) else {
+            let Ok(octree) = Octree::build(&renderer.scene.shapes, params) else {
+                continue;
+            };
+            let build_s = start.elapsed().as_secs_f64();
+            let Ok(sample) = sample_rays(renderer, &octree) else {
                 continue;
             };
             candidates.push(OctreeCandidate {
                 params,
-                build_s: start.elapsed().as_secs_f64(),
+                build_s,
                 predicted: costs.predict(octree.predicted_cost(), rays, threads),
+                predicted_from_rays: sample.predict(rays, threads),
             });
         }
     }
@@ -245,4 +334,100 @@ pub fn suggest_octree(
             .total_cmp(&candidates[b].predicted_total_s())
     })?;
     Some((candidates, best))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::CameraSpec;
+    use crate::material::{Light, Material};
+    use crate::scene::{ImageSettings, Scene};
+    use crate::shapes::Sphere;
+
+    /// A 6x6x6 lattice of small spheres around the origin, seen from
+    /// `eye` looking at `lookat`, `width` x `height` pixels.
+    fn lattice(eye: DVec3, lookat: DVec3, width: u32, height: u32) -> Scene {
+        let mut scene = Scene::empty(
+            "lattice".into(),
+            CameraSpec {
+                eye,
+                lookat,
+                up: DVec3::Y,
+                fov: 40.0,
+            },
+            ImageSettings {
+                width,
+                height,
+                samples: 1,
+                max_depth: 3,
+                ..ImageSettings::default()
+            },
+        );
+        scene.materials = vec![Material {
+            reflectivity: 0.3,
+            ..Material::default()
+        }];
+        scene.lights = vec![Light {
+            position: DVec3::new(4.0, 9.0, 7.0),
+            color: DVec3::ONE,
+        }];
+        for i in 0..216 {
+            let p = DVec3::new((i % 6) as f64, (i / 6 % 6) as f64, (i / 36) as f64) - 2.5;
+            scene.push(Shape::Sphere(Sphere::new(p, 0.3)), 0);
+        }
+        scene
+    }
+
+    #[test]
+    fn the_ray_sample_of_a_thumbnail_sized_render_is_that_render() {
+        // At 40x30 and one sample the thumbnail is the render itself: the
+        // sample's work per ray is the counted render's, exactly.
+        let scene = lattice(DVec3::new(3.0, 4.0, 12.0), DVec3::ZERO, 40, 30);
+        let octree = scene.build_octree().unwrap();
+        let renderer = Renderer::new(&scene, &octree, scene.render_settings()).unwrap();
+        let counts = renderer.render(true, None).1;
+        let rays = counts.rays.total() as f64;
+        let sample = sample_rays(&renderer, &octree).unwrap();
+        assert_eq!(sample.rays, counts.rays.total());
+        assert_eq!(
+            sample.traversal_steps_per_ray,
+            counts.work.traversal_steps as f64 / rays
+        );
+        assert_eq!(
+            sample.intersection_tests_per_ray,
+            counts.work.intersection_tests as f64 / rays
+        );
+        assert!(sample.intersection_tests_per_ray > 0.0);
+    }
+
+    #[test]
+    fn the_ray_sample_sees_what_the_view_does_and_the_tree_alone_cannot() {
+        // The same tree seen from a camera that looks away from it: no ray
+        // reaches its box, so the sample counts no work at all, while the
+        // surface-area model (view-independent) predicts the same as
+        // before. Seen square on, the sample counts work, and fewer tests
+        // per ray than the model's upper bound (rays stop at their first
+        // hit).
+        let towards = lattice(DVec3::new(3.0, 4.0, 12.0), DVec3::ZERO, 320, 240);
+        let away = lattice(
+            DVec3::new(3.0, 4.0, 12.0),
+            DVec3::new(3.0, 4.0, 20.0),
+            320,
+            240,
+        );
+        let octree = towards.build_octree().unwrap();
+        let sample = |scene: &Scene| {
+            let renderer = Renderer::new(scene, &octree, scene.render_settings()).unwrap();
+            sample_rays(&renderer, &octree).unwrap()
+        };
+        let (seen, unseen) = (sample(&towards), sample(&away));
+        assert_eq!(unseen.traversal_steps_per_ray, 0.0);
+        assert_eq!(unseen.intersection_tests_per_ray, 0.0);
+        let model = octree.predicted_cost();
+        assert!(seen.intersection_tests_per_ray > 0.0);
+        assert!(
+            seen.intersection_tests_per_ray < model.intersection_tests_per_ray,
+            "{seen:?} {model:?}"
+        );
+    }
 }

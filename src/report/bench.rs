@@ -7,7 +7,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::accel::{OctreeError, OctreeParams, OctreeStats};
-use crate::render::{Prediction, RenderError, Renderer, UnitCosts};
+use crate::render::{Prediction, RenderError, Renderer, UnitCosts, sample_rays};
 use crate::scene::Scene;
 use crate::settings::{Protocol, RenderSettings};
 use crate::simd::SimdLevel;
@@ -47,6 +47,9 @@ pub struct SceneBench {
     /// `octree_on` as predicted from the tree alone (docs/speed-and-accuracy.md,
     /// "Predicting an octree's cost"), at `unit_costs`.
     pub predicted: Prediction,
+    /// `octree_on` as predicted from a sample of the render's own rays (a
+    /// 64-pixel thumbnail traced through the tree, counted and timed).
+    pub predicted_from_rays: Prediction,
     pub unit_costs: UnitCosts,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub octree_off: Option<Timing>,
@@ -183,6 +186,7 @@ pub fn bench_scene(
     let renderer_on = Renderer::new(scene, &octree, on)?;
     let renderer_off = Renderer::new(scene, &octree, off)?;
     let unit_costs = UnitCosts::measure(&renderer_on, &octree)?;
+    let ray_sample = sample_rays(&renderer_on, &octree)?;
 
     // One counted pass of each for the machine-independent figures.
     check()?;
@@ -277,6 +281,7 @@ pub fn bench_scene(
         octree_stats: octree.stats(),
         octree_on: timing(&counted_on, on_s, rays_total as f64, false),
         predicted: unit_costs.predict(octree.predicted_cost(), rays_total, threads),
+        predicted_from_rays: ray_sample.predict(rays_total, threads),
         unit_costs,
         // The whole-image estimate, with throughput measured on the subset.
         octree_off: counted_off

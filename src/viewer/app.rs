@@ -16,7 +16,7 @@ use octree_tuning::build_octree;
 use super::command::Command;
 use super::compare::{Compare, CompareMode, DiffStats};
 use super::inspect::InspectState;
-use super::octree_panel::{OctreeInfo, SuggestionJob, last_full_pass};
+use super::octree_panel::{OctreeInfo, RaySampleJob, SuggestionJob, last_full_pass};
 use super::orbit_bench::{OrbitBench, OrbitBenchOptions, ShownFrame};
 use super::panels::{Message, RenderInfo};
 use super::pixel::Inspection;
@@ -116,6 +116,9 @@ pub struct GlintApp {
     unit_costs: Option<UnitCosts>,
     /// A suggested octree setting, being worked out or found.
     suggestion: Option<SuggestionJob>,
+    /// A tree's work per ray on a thumbnail of the view (the octree
+    /// panel's prediction from rays), for the tree it was measured on.
+    ray_sample: Option<RaySampleJob>,
     worker: Worker,
     texture: Option<TextureHandle>,
     shown_version: u64,
@@ -178,6 +181,7 @@ impl GlintApp {
             build_seconds,
             unit_costs: None,
             suggestion: None,
+            ray_sample: None,
             worker,
             texture: None,
             shown_version: 0,
@@ -408,6 +412,11 @@ impl GlintApp {
                     last_pass: last_full_pass(&history),
                     threads: self.worker.threads(),
                     suggestion: self.suggestion.as_ref(),
+                    ray_sample: self.ray_sample.as_ref().and_then(RaySampleJob::result),
+                    ray_sample_taken: self
+                        .ray_sample
+                        .as_ref()
+                        .is_some_and(|job| Arc::ptr_eq(&job.octree, &self.octree)),
                 };
                 commands.extend(panels::controls_ui(
                     &mut self.edit,
@@ -574,6 +583,7 @@ impl GlintApp {
                 Command::PinAsA => self.pin_as_a(),
                 Command::SetOctreeParams(params) => self.set_octree_params(params),
                 Command::SuggestOctree => self.suggest_octree(),
+                Command::SampleRays => self.sample_rays(),
                 Command::Quit => ctx.send_viewport_cmd(egui::ViewportCommand::Close),
             }
         }

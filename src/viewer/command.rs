@@ -32,5 +32,8 @@ pub enum Command {
     SetOctreeParams(crate::accel::OctreeParams),
     /// Work out a suggested octree setting in the background.
     SuggestOctree,
+    /// Sample the view's rays through the current tree in the background
+    /// (asked for by the octree panel while it is open).
+    SampleRays,
     Quit,
 }

@@ -10,10 +10,14 @@ use egui::DragValue;
 use super::command::Command;
 use super::worker::PassRecord;
 use crate::accel::{Octree, OctreeParams};
+use crate::camera::CameraSpec;
 use crate::limits::MAX_OCTREE_DEPTH;
 use crate::render::PassKind as Engine;
-use crate::render::{OctreeCandidate, Prediction, UnitCosts, suggest_octree};
+use crate::render::{
+    OctreeCandidate, Prediction, RaySample, Renderer, UnitCosts, sample_rays, suggest_octree,
+};
 use crate::scene::Scene;
+use crate::settings::RenderSettings;
 
 /// A suggestion being worked out on its own thread, for one scene version.
 pub struct SuggestionJob {
@@ -25,10 +29,12 @@ pub struct SuggestionJob {
 }
 
 impl SuggestionJob {
-    /// Builds the suggestion grid's trees (renders nothing) for `rays`
-    /// rays on `threads` threads.
+    /// Builds the suggestion grid's trees and traces a thumbnail of the
+    /// view through each (renders nothing else) for `rays` rays on
+    /// `threads` threads. `octree` is the current tree (the renderer the
+    /// thumbnails start from needs one).
     pub fn start(
-        scene: Arc<Scene>,
+        view: SuggestionView,
         costs: UnitCosts,
         rays: u64,
         threads: usize,
@@ -39,14 +45,12 @@ impl SuggestionJob {
         let (out, stop) = (Arc::clone(&result), Arc::clone(&cancel));
         std::thread::spawn(move || {
             let keep_going = || !stop.load(Ordering::Relaxed);
-            let found = suggest_octree(
-                &scene.shapes,
-                scene.octree_params,
-                &costs,
-                rays,
-                threads,
-                &keep_going,
-            );
+            let found =
+                Renderer::with_camera(&view.scene, &view.octree, view.settings, &view.camera)
+                    .ok()
+                    .and_then(|renderer| {
+                        suggest_octree(&renderer, &costs, rays, threads, &keep_going)
+                    });
             if let Ok(mut slot) = out.lock() {
                 *slot = Some(found.map(|(candidates, best)| candidates[best]));
             }
@@ -70,6 +74,51 @@ impl Drop for SuggestionJob {
     }
 }
 
+/// The current tree's [`RaySample`], taken on its own thread (a thumbnail
+/// of the view traced four times: up to a few tenths of a second on the
+/// heaviest bundled scenes, too long for the frame it would stall).
+pub struct RaySampleJob {
+    pub octree: Arc<Octree>,
+    /// `None` while it runs; then the sample (`None` if the view could not
+    /// be rendered).
+    result: Arc<Mutex<Option<Option<RaySample>>>>,
+}
+
+impl RaySampleJob {
+    pub fn start(view: SuggestionView) -> Self {
+        let result = Arc::new(Mutex::new(None));
+        let out = Arc::clone(&result);
+        let octree = Arc::clone(&view.octree);
+        std::thread::spawn(move || {
+            let sample =
+                Renderer::with_camera(&view.scene, &view.octree, view.settings, &view.camera)
+                    .and_then(|renderer| sample_rays(&renderer, &view.octree));
+            if let Ok(mut slot) = out.lock() {
+                *slot = Some(sample.ok());
+            }
+        });
+        Self { octree, result }
+    }
+
+    /// `None` while it runs or if the view could not be rendered.
+    pub fn result(&self) -> Option<RaySample> {
+        self.result.lock().ok().and_then(|r| r.flatten())
+    }
+
+    pub fn is_running(&self) -> bool {
+        self.result.lock().is_ok_and(|r| r.is_none())
+    }
+}
+
+/// The view a suggestion or a ray sample is worked out for: its
+/// thumbnails are of it.
+pub struct SuggestionView {
+    pub scene: Arc<Scene>,
+    pub octree: Arc<Octree>,
+    pub settings: RenderSettings,
+    pub camera: CameraSpec,
+}
+
 /// What the panel shows besides the parameters.
 pub struct OctreeInfo<'a> {
     pub octree: &'a Octree,
@@ -80,6 +129,11 @@ pub struct OctreeInfo<'a> {
     pub last_pass: Option<&'a PassRecord>,
     pub threads: usize,
     pub suggestion: Option<&'a SuggestionJob>,
+    /// The current tree's work per ray on a thumbnail of the view as it
+    /// was when the tree was built (`None` until measured).
+    pub ray_sample: Option<RaySample>,
+    /// Whether the current tree's sample is taken or being taken.
+    pub ray_sample_taken: bool,
 }
 
 /// The last pass that was not a drag preview.
@@ -87,8 +141,9 @@ pub fn last_full_pass(history: &[PassRecord]) -> Option<&PassRecord> {
     history.iter().rev().find(|r| r.kind.preview.is_none())
 }
 
-/// The prediction for the current tree and the last pass's rays.
-pub fn prediction(info: &OctreeInfo) -> Option<(Prediction, &'static str)> {
+/// The predictions for the current tree and the last pass's rays, from
+/// the tree alone and (once measured) from the sample of rays.
+pub fn prediction(info: &OctreeInfo) -> Option<(Prediction, Option<Prediction>, &'static str)> {
     let costs = info.unit_costs?;
     let pass = info.last_pass?;
     let kind = match pass.kind.pass {
@@ -96,12 +151,11 @@ pub fn prediction(info: &OctreeInfo) -> Option<(Prediction, &'static str)> {
         Engine::Corners => "SPD pass",
         Engine::OneSample => "1-sample pass",
     };
+    let rays = pass.rays.total();
     Some((
-        costs.predict(
-            info.octree.predicted_cost(),
-            pass.rays.total(),
-            info.threads,
-        ),
+        costs.predict(info.octree.predicted_cost(), rays, info.threads),
+        info.ray_sample
+            .map(|sample| sample.predict(rays, info.threads)),
         kind,
     ))
 }
@@ -158,20 +212,53 @@ pub fn octree_ui(params: OctreeParams, info: &OctreeInfo, ui: &mut egui::Ui) -> 
     ));
     let cost = info.octree.predicted_cost();
     ui.label(format!(
-        "Predicted per ray: {:.1} traversal steps, {:.1} intersection tests",
+        "Predicted per ray from the tree: {:.1} traversal steps, {:.1} intersection tests",
         cost.traversal_steps_per_ray, cost.intersection_tests_per_ray
     ))
     .on_hover_text(
         "from the tree alone (surface areas: a ray crossing a cell crosses each octant with \
          chance 1/4), for rays that cross the scene's box, ignoring that rays stop at their \
-         first hit: an upper bound, good for comparing settings",
+         first hit: an upper bound, good for comparing settings of one scene",
     );
-    if let Some((p, kind)) = prediction(info) {
-        ui.label(format!(
-            "Predicted {kind}: {:.2} s (build + render {:.2} s)",
-            p.render_s,
-            info.build_seconds + p.render_s
-        ));
+    // Sampled only while the panel is open: nobody else reads it, and it
+    // would compete with the passes for the cores.
+    if !info.ray_sample_taken && info.last_pass.is_some() {
+        commands.push(Command::SampleRays);
+    }
+    let sample_text = match info.ray_sample {
+        Some(sample) => format!(
+            "From a sample of the view's rays: {:.1} traversal steps, {:.1} intersection tests",
+            sample.traversal_steps_per_ray, sample.intersection_tests_per_ray
+        ),
+        // The line is there from the start, so the button below does not
+        // move under the pointer when the sample comes in.
+        None => "From a sample of the view's rays: tracing a thumbnail…".to_owned(),
+    };
+    ui.label(sample_text).on_hover_text(
+        "a 64-pixel thumbnail of the view when the tree was built, its shadow and secondary \
+         rays included, traced through this tree with the walk's counters and timed: what \
+         the view's rays actually do, so it holds across scenes \
+         (docs/speed-and-accuracy.md)",
+    );
+    if let Some((p, from_rays, kind)) = prediction(info) {
+        let total = |p: Prediction| info.build_seconds + p.render_s;
+        ui.label(match from_rays {
+            Some(q) => format!(
+                "Predicted {kind}: {:.2} s from the rays, {:.2} s from the tree \
+                 (build + render {:.2} s)",
+                q.render_s,
+                p.render_s,
+                total(q)
+            ),
+            None => format!(
+                "Predicted {kind}: {:.2} s (build + render {:.2} s)",
+                p.render_s,
+                total(p)
+            ),
+        });
+        if let Some(pass) = info.last_pass.filter(|p| p.octree && !p.from_cache) {
+            ui.label(format!("Measured, the last {kind}: {:.2} s", pass.seconds));
+        }
     }
     ui.horizontal(|ui| {
         let running = info.suggestion.is_some_and(|s| s.result().is_none());
@@ -179,8 +266,8 @@ pub fn octree_ui(params: OctreeParams, info: &OctreeInfo, ui: &mut egui::Ui) -> 
         if ui
             .add_enabled(can_suggest, egui::Button::new("Suggest a setting"))
             .on_hover_text(
-                "build the tree at max depths 4-12 and leaf sizes 1-16 (renders nothing) and \
-                 pick the least build + predicted render time",
+                "build the tree at max depths 4-12 and leaf sizes 1-16, trace a thumbnail of the \
+                 view through each, and pick the least build + predicted render time",
             )
             .clicked()
         {

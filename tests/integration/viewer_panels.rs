@@ -90,6 +90,14 @@ fn octree_parameters_rebuild_the_tree_and_its_prediction_and_render_again() {
         })
         .count();
     assert!(shown > 0, "the predicted render time is shown");
+    // And, once its thread has traced a thumbnail of the view through the
+    // new tree, the prediction from a sample of the view's rays.
+    let start = std::time::Instant::now();
+    while ray_sample_lines(&h) == 0 {
+        assert!(start.elapsed() < WAIT, "no prediction from the view's rays");
+        std::thread::sleep(Duration::from_millis(20));
+        h.run_steps(1);
+    }
 }
 
 #[test]
@@ -210,6 +218,13 @@ fn the_suggestions_apply_button_is_whole() {
     settle(&mut h);
     h.get_by_label("Octree parameters").click();
     h.run_steps(3);
+    // The panel's lines settle once the view's ray sample is in.
+    let start = std::time::Instant::now();
+    while ray_sample_lines(&h) == 0 {
+        assert!(start.elapsed() < WAIT, "no prediction from the view's rays");
+        std::thread::sleep(Duration::from_millis(20));
+        h.run_steps(1);
+    }
     h.get_by_label("Suggest a setting").click();
     let start = std::time::Instant::now();
     while h.query_by_label("Apply").is_none() {
@@ -254,4 +269,14 @@ fn the_ray_tree_fits_the_right_panel() {
             "{text:?} at {rect:?}"
         );
     }
+}
+
+/// Lines of the octree panel that show the view's ray sample, measured.
+fn ray_sample_lines(h: &egui_kittest::Harness<'static, GlintApp>) -> usize {
+    h.query_all_by(|n| {
+        n.label().or(n.value()).is_some_and(|t| {
+            t.starts_with("From a sample of the view's rays: ") && t.contains("tests")
+        })
+    })
+    .count()
 }

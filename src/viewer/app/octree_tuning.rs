@@ -9,7 +9,7 @@ use crate::accel::{Octree, OctreeParams};
 use crate::render::{Renderer, UnitCosts};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
-use crate::viewer::octree_panel::{SuggestionJob, last_full_pass};
+use crate::viewer::octree_panel::{RaySampleJob, SuggestionJob, SuggestionView, last_full_pass};
 
 impl GlintApp {
     /// Edits the octree parameters (an edit like any other: undone,
@@ -48,12 +48,37 @@ impl GlintApp {
             return;
         };
         self.suggestion = Some(SuggestionJob::start(
-            Arc::clone(&self.edit.scene),
+            self.view_for_octree(),
             costs,
             pass.rays.total(),
             self.worker.threads(),
             self.edit.scene_version,
         ));
+    }
+
+    /// Samples the view's rays through the current tree on a thread of its
+    /// own, once per tree (not again as the camera moves).
+    pub(super) fn sample_rays(&mut self) {
+        let taken = self
+            .ray_sample
+            .as_ref()
+            .is_some_and(|job| Arc::ptr_eq(&job.octree, &self.octree));
+        if !taken {
+            self.ray_sample = Some(RaySampleJob::start(self.view_for_octree()));
+        }
+    }
+
+    /// The scene, tree and view as they are now, for work on other threads.
+    fn view_for_octree(&self) -> SuggestionView {
+        SuggestionView {
+            scene: Arc::clone(&self.edit.scene),
+            octree: Arc::clone(&self.octree),
+            settings: RenderSettings {
+                use_octree: true,
+                ..self.edit.settings
+            },
+            camera: self.edit.camera,
+        }
     }
 
     /// Measures the unit costs of the installed scene once its first pass
@@ -84,6 +109,13 @@ impl GlintApp {
             {
                 self.unit_costs = UnitCosts::measure(&renderer, &self.octree).ok();
             }
+        }
+        if self
+            .ray_sample
+            .as_ref()
+            .is_some_and(RaySampleJob::is_running)
+        {
+            ctx.request_repaint_after(std::time::Duration::from_millis(100));
         }
     }
 }
