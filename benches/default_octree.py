@@ -1,0 +1,66 @@
+#!/usr/bin/env python3
+"""Whether the octree a scene gets by default ever loses: for each scene,
+build + render with the default octree against brute force (octree off)
+and against the fastest setting of a sweep (maximum depths 6, 8, 10,
+leaf sizes 2 and 8, the cost-driven stop on and off), and the peak resident memory
+of a render with the octree against one without (what the tree adds)
+beside the memory budget. One sample per pixel, so the build weighs as
+much as it ever does. Prints a markdown table.
+
+    python3 benches/default_octree.py [SCENE ...]
+
+Without arguments: every bundled scene at its own size and the SPD scenes
+at 512x512. The SPD generator's `shells` (sizes 2-4) is not bundled;
+generate it and pass the files.
+"""
+
+import glob
+import json
+import os
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+GLINT = os.path.join(ROOT, "target", "release", "glint")
+
+
+def glint_json(*args):
+    out = subprocess.run([GLINT, *args], cwd=ROOT, check=True, capture_output=True, text=True)
+    return json.loads(out.stdout)
+
+
+def peak_mib(*args):
+    """Peak resident memory of `glint render ARGS` in MiB (GNU time)."""
+    out = subprocess.run(["/usr/bin/time", "-f", "%M", GLINT, "render", "--quiet", *args],
+                         cwd=ROOT, check=True, capture_output=True, text=True)
+    return int(out.stderr.strip().splitlines()[-1]) / 1024
+
+
+def size_args(scene):
+    return ["--size", "512x512"] if scene.endswith(".nff") else []
+
+
+scenes = sys.argv[1:] or sorted(glob.glob(os.path.join(ROOT, "scenes", "*.toml"))) + sorted(
+    glob.glob(os.path.join(ROOT, "scenes", "spd", "*.nff")))
+print("| scene | shapes | default: build + render (s) | octree off (s) | sweep's fastest (s) | default / fastest | default / off | tree's peak memory (MiB) |")
+print("|---|---:|---:|---:|---:|---:|---:|---:|")
+worst_fastest, worst_off = 0.0, 0.0
+for scene in scenes:
+    common = [scene, "--samples", "1", *size_args(scene)]
+    [b] = glint_json("bench", *common, "--repeat", "3", "--format", "json")
+    default_s = b["build_s"] + b["octree_on"]["render_s"]
+    off_s = b["octree_off"]["render_s"]
+    sweep = glint_json("bench", *common, "--repeat", "1", "--sweep", "--sweep-depths", "6,8,10",
+                       "--sweep-leaf-sizes", "2,8", "--sweep-cost-driven", "on,off",
+                       "--format", "json")
+    fastest = min([r["build_s"] + r["render_s"] for r in sweep] + [default_s])
+    # The tree is the same at any image size: a small render keeps brute
+    # force quick on the big meshes.
+    out = os.path.join("/tmp", "default_octree.png")
+    small = [scene, "--samples", "1", "--width", "32", "--height", "24"]
+    tree_mib = peak_mib(*small, "-o", out) - peak_mib(*small, "--octree", "off", "-o", out)
+    worst_fastest = max(worst_fastest, default_s / fastest)
+    worst_off = max(worst_off, default_s / off_s)
+    print(f"| {os.path.basename(scene)} | {b['shapes']} | {default_s:.3f} | {off_s:.3f} | {fastest:.3f} "
+          f"| {default_s / fastest:.2f} | {default_s / off_s:.2f} | {tree_mib:.0f} |", flush=True)
+print(f"\nWorst: default / fastest {worst_fastest:.2f}, default / octree off {worst_off:.2f}.")
