@@ -14,7 +14,7 @@ use crate::accel::{
 };
 use crate::math::{Aabb, DVec3, Ray, orthonormal_basis};
 use crate::shapes::{PreparedRay, Shape};
-use crate::stats::{NoCounts, WorkCounts};
+use crate::stats::{NoCounts, RenderCounts, WorkCounts};
 
 use super::renderer::{RenderError, Renderer};
 
@@ -91,14 +91,9 @@ impl UnitCosts {
 
         // A thumbnail of the render, one thread, for what else a ray costs.
         let thumbnail = thumbnail(renderer, octree, 48)?;
-        let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build();
+        let on_one_thread = on_one_thread(&thumbnail);
         let mut counts = Default::default();
-        let render_s = fastest_of_3(|| {
-            counts = match &one_thread {
-                Ok(pool) => pool.install(|| thumbnail.render(true, None).1),
-                Err(_) => thumbnail.render(true, None).1,
-            };
-        });
+        let render_s = fastest_of_3(|| counts = on_one_thread(true));
         let rays = counts.rays.total().max(1) as f64;
         let work = counts.work;
         let ray_ns = positive(
@@ -144,6 +139,17 @@ fn thumbnail<'a>(
     Renderer::with_camera(renderer.scene, octree, settings, &renderer.camera_spec)
 }
 
+/// Renders `thumbnail` (counted or not) on a pool of one thread, for
+/// timings that do not depend on the machine's cores (on the caller's pool
+/// if one cannot be made).
+fn on_one_thread<'a>(thumbnail: &'a Renderer) -> impl Fn(bool) -> RenderCounts + 'a {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build();
+    move |counted| match &pool {
+        Ok(pool) => pool.install(|| thumbnail.render(counted, None).1),
+        Err(_) => thumbnail.render(counted, None).1,
+    }
+}
+
 /// The longer side of the image [`sample_rays`] traces: 64 x 48 eye rays
 /// on a 4:3 view, with their shadow and secondary rays.
 pub const RAY_SAMPLE_SIDE: u32 = 64;
@@ -161,14 +167,6 @@ pub struct RaySample {
 }
 
 impl RaySample {
-    /// The work per ray alone.
-    pub fn cost(&self) -> PredictedCost {
-        PredictedCost {
-            traversal_steps_per_ray: self.traversal_steps_per_ray,
-            intersection_tests_per_ray: self.intersection_tests_per_ray,
-        }
-    }
-
     /// A render of `rays` rays on `threads` threads (taken as scaling
     /// perfectly), at the sample's time per ray.
     pub fn predict(&self, rays: u64, threads: usize) -> Prediction {
@@ -192,11 +190,7 @@ impl RaySample {
 /// same on any number of threads; the time is taken on one.
 pub fn sample_rays(renderer: &Renderer, octree: &Octree) -> Result<RaySample, RenderError> {
     let thumbnail = thumbnail(renderer, octree, RAY_SAMPLE_SIDE)?;
-    let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build();
-    let on_one_thread = |counted: bool| match &one_thread {
-        Ok(pool) => pool.install(|| thumbnail.render(counted, None).1),
-        Err(_) => thumbnail.render(counted, None).1,
-    };
+    let on_one_thread = on_one_thread(&thumbnail);
     let counts = on_one_thread(true);
     let seconds = fastest_of_3(|| {
         on_one_thread(false);

@@ -30,9 +30,8 @@ pub struct SuggestionJob {
 
 impl SuggestionJob {
     /// Builds the suggestion grid's trees and traces a thumbnail of the
-    /// view through each (renders nothing else) for `rays` rays on
-    /// `threads` threads. `octree` is the current tree (the renderer the
-    /// thumbnails start from needs one).
+    /// view through each (renders nothing else), predicting a render of
+    /// `rays` rays on `threads` threads.
     pub fn start(
         view: SuggestionView,
         costs: UnitCosts,
