@@ -147,7 +147,9 @@ fn pin_as_a_then_octree_off_reads_zero_pixels_differ() {
 /// "rendering…", nothing is "kept", the status is not "done".
 #[test]
 fn an_octree_toggle_renders_and_the_panel_waits_for_the_new_figures() {
-    let mut app = app_for("scenes/default.toml", 160, 120);
+    // 96x72: a brute-force pass takes about 2 s here, long enough to be
+    // caught mid-pass two frames after the switch.
+    let mut app = app_for("scenes/default.toml", 96, 72);
     app.set_anti_aliasing(AntiAliasing::Off);
     let mut h = harness(app);
     settle(&mut h);
@@ -505,13 +507,13 @@ fn the_image_is_magnified_by_whole_pixels_to_fit_or_one_to_one() {
     assert_eq!((actual.width() * ppp, actual.height() * ppp), (64.0, 48.0));
 }
 
-/// Stop ends a long pass (here brute force on 91,850 triangles) within a
-/// tile per thread and keeps the image as far as it got; the next job
-/// renders as usual.
+/// Stop ends a long pass (here brute force on the default scene's bunny,
+/// about 0.15 s a tile) within a tile per thread and keeps the image as
+/// far as it got; the next job renders as usual.
 #[test]
 fn a_long_pass_can_be_stopped_and_the_next_change_renders_again() {
     let worker = Worker::spawn(2, || {});
-    let (mut slow, _, _) = job("scenes/bunnies.toml", 96, 72, AntiAliasing::Full);
+    let (mut slow, _, _) = job("scenes/default.toml", 96, 72, AntiAliasing::Full);
     slow.settings.use_octree = false;
     let generation = worker.submit(slow);
     let start = std::time::Instant::now();
