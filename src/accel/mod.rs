@@ -1,12 +1,14 @@
 //! Ray queries over a scene's shapes: brute force over every shape, or
-//! through the [`Octree`]. Both answer exactly the same: ties between equal
-//! distances go to the lower shape index in both.
+//! through the [`Octree`] or a [`Bvh`]. All answer exactly the same: ties
+//! between equal distances go to the lower shape index in each.
 
+mod bvh;
 mod octree;
 mod primitives;
 mod walk_log;
 
 pub use crate::stats::walk_record::{CellVisit, QueryRecord, StepKind, Tested, WalkEnd, WalkStep};
+pub use bvh::{Bvh, BvhStack, BvhStats};
 pub use octree::{
     Baseline, BoxLanes, DEFAULT_MEMORY_BUDGET_MIB, Octree, OctreeCell, OctreeError, OctreeParams,
     OctreeStats, PacketStack, PredictedCost, WalkStack,

@@ -1,11 +1,11 @@
 //! A scene prepared for rendering with fixed settings: the camera built,
 //! materials in the convention the render shades in, which shapes are
-//! one-sided or transparent, and the ray queries (octree or brute force)
-//! the integrator asks.
+//! one-sided or transparent, and the ray queries (octree, BVH or brute
+//! force) the integrator asks.
 
 use crate::accel::{
-    ClosestHit, Octree, Primitives, ShadowCrossings, WalkLog, WalkStack, closest_brute_force,
-    occlusion_brute_force,
+    Bvh, BvhStack, ClosestHit, Octree, Primitives, ShadowCrossings, WalkLog, WalkStack,
+    closest_brute_force, occlusion_brute_force,
 };
 use crate::camera::{Camera, CameraError, CameraSpec, sample_offsets};
 use crate::limits::LimitError;
@@ -38,12 +38,13 @@ pub enum RenderError {
     },
 }
 
-/// Scratch space for ray queries: the octree walk's stack and a shadow
-/// ray's crossings. One per tile (or per inspected pixel), so no ray sets
-/// them up.
+/// Scratch space for ray queries: the octree walk's and the BVH's stacks
+/// and a shadow ray's crossings. One per tile (or per inspected pixel), so
+/// no ray sets them up.
 #[derive(Default)]
 pub struct Scratch {
     stack: WalkStack,
+    bvh: BvhStack,
     crossings: ShadowCrossings,
 }
 
@@ -118,6 +119,9 @@ const SAME_SURFACE_RELATIVE: f64 = 1e-9;
 pub struct Renderer<'a> {
     pub(super) scene: &'a Scene,
     pub(super) octree: &'a Octree,
+    /// When given, every query goes through it instead of the octree or
+    /// brute force ([`Renderer::with_bvh`]).
+    bvh: Option<&'a Bvh>,
     pub(super) settings: RenderSettings,
     pub(super) camera: Camera,
     /// What `camera` was made from (a thumbnail of the same view needs it).
@@ -186,6 +190,7 @@ impl<'a> Renderer<'a> {
         Ok(Self {
             scene,
             octree,
+            bvh: None,
             settings,
             camera,
             camera_spec,
@@ -239,6 +244,20 @@ impl<'a> Renderer<'a> {
         self.simd
     }
 
+    /// Renders through `bvh` (built over this scene's shapes) instead of
+    /// the octree or brute force, whatever `use_octree` says: the bytes
+    /// are the same, only the time and the work counted differ. Its rays go
+    /// one at a time (the packet walks are the octree's).
+    pub fn with_bvh(mut self, bvh: &'a Bvh) -> Self {
+        self.bvh = Some(bvh);
+        self
+    }
+
+    /// Whether eye rays go through the octree's packet walk.
+    pub(super) fn packets_through_octree(&self) -> bool {
+        self.settings.use_octree && self.bvh.is_none()
+    }
+
     pub(super) fn primitives(&self) -> Primitives<'_> {
         Primitives {
             shapes: &self.scene.shapes,
@@ -253,6 +272,15 @@ impl<'a> Renderer<'a> {
         query: &mut Query<C>,
     ) -> Option<ClosestHit> {
         let prims = self.primitives();
+        if let Some(bvh) = self.bvh {
+            return bvh.closest(
+                &prims,
+                ray,
+                f64::INFINITY,
+                &mut query.scratch.bvh,
+                query.counter,
+            );
+        }
         if self.settings.use_octree {
             let stack = &mut query.scratch.stack;
             if !C::COUNTS
@@ -290,8 +318,14 @@ impl<'a> Renderer<'a> {
         query: &mut Query<C>,
     ) -> f64 {
         let prims = self.primitives();
-        let Scratch { stack, crossings } = &mut *query.scratch;
-        if self.settings.use_octree {
+        let Scratch {
+            stack,
+            bvh,
+            crossings,
+        } = &mut *query.scratch;
+        if let Some(tree) = self.bvh {
+            tree.occlusion(&prims, ray, distance, crossings, bvh, query.counter);
+        } else if self.settings.use_octree {
             match self.single_rays.avx2() {
                 Some(simd) if !C::COUNTS => pulp::Simd::vectorize(
                     simd,

@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-use crate::accel::{Octree, OctreeParams, OctreeStats};
+use crate::accel::{BvhStats, Octree, OctreeParams, OctreeStats};
 use crate::color::ColorConvention;
 use crate::render::RenderedFrame;
 use crate::scene::{DroppedPolygons, MeshCounts, Scene, SkippedElements};
@@ -22,7 +22,10 @@ pub struct RenderStats {
     pub samples: u32,
     pub max_depth: u32,
     pub threads: usize,
+    /// Whether the octree answered the ray queries.
     pub octree: bool,
+    /// What answered them: `octree`, `bvh` or `none` (brute force).
+    pub accel: &'static str,
     pub octree_params: OctreeParams,
     pub view: ViewMode,
     pub protocol: Protocol,
@@ -61,6 +64,9 @@ pub struct RenderStats {
     pub load_notes: Vec<String>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub octree_stats: Option<OctreeStats>,
+    /// With `--accel bvh`: what its build made (`build_s` is its build).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bvh_stats: Option<BvhStats>,
     /// With `--view cost` or `cost-steps`: the per-pixel count's range.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cost_per_pixel: Option<CostJson>,
@@ -119,6 +125,11 @@ impl RenderStats {
             max_depth: settings.max_depth,
             threads,
             octree: settings.use_octree,
+            accel: if settings.use_octree {
+                "octree"
+            } else {
+                "none"
+            },
             octree_params: scene.octree_params,
             view: settings.view,
             protocol: settings.protocol,
@@ -154,11 +165,23 @@ impl RenderStats {
             not_rendered: scene.not_rendered.clone(),
             load_notes: scene.load_notes.clone(),
             octree_stats: settings.use_octree.then(|| octree.stats()),
+            bvh_stats: None,
             cost_per_pixel: frame.cost_summary().map(|c| CostJson {
                 min: c.min,
                 max: c.max,
                 mean: c.mean,
             }),
+        }
+    }
+
+    /// The statistics of a render through a BVH (the octree off).
+    pub fn with_bvh(self, stats: BvhStats) -> Self {
+        Self {
+            octree: false,
+            accel: "bvh",
+            octree_stats: None,
+            bvh_stats: Some(stats),
+            ..self
         }
     }
 }

@@ -6,6 +6,7 @@
 
 mod common;
 
+mod accelerators;
 mod adaptive_aa;
 mod cli_output;
 mod cli_records;

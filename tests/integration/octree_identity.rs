@@ -1,19 +1,22 @@
-//! The octree answers exactly what brute force answers: images are
-//! byte-identical, and random rays agree on the closest hit and on shadows.
+//! The octree and the BVH answer exactly what brute force answers: images
+//! are byte-identical, and random rays agree on the closest hit and on
+//! shadows.
 
 use crate::common;
 
 use common::{all_scenes, render_with};
 use glint::accel::{
-    Octree, OctreeParams, Primitives, ShadowCrossings, closest_brute_force, occlusion_brute_force,
+    Bvh, BvhStack, Octree, OctreeParams, Primitives, ShadowCrossings, closest_brute_force,
+    occlusion_brute_force,
 };
 use glint::math::{DVec3, Ray};
+use glint::render::Renderer;
 use glint::shapes::{PreparedRay, Shape, Sphere, Triangle};
 use glint::stats::{NoCounts, WorkCounts};
 use proptest::prelude::*;
 
 #[test]
-fn octree_on_and_off_give_identical_bytes_for_every_scene() {
+fn octree_on_and_off_and_the_bvh_give_identical_bytes_for_every_scene() {
     for name in all_scenes() {
         let loaded = common::loaded(&name);
         let (scene, octree) = (&loaded.0, &loaded.1);
@@ -38,6 +41,24 @@ fn octree_on_and_off_give_identical_bytes_for_every_scene() {
             "{name}: {differing} pixels differ between octree on and off"
         );
         assert_eq!(c_on.rays, c_off.rays, "{name}: different rays were cast");
+        let bvh = Bvh::build(&scene.shapes);
+        let mut settings = scene.render_settings();
+        (settings.width, settings.height, settings.samples) = (side, side, 1);
+        let renderer = Renderer::new(scene, octree, settings)
+            .unwrap()
+            .with_bvh(&bvh);
+        let (frame, c_bvh) = renderer.render(true, None);
+        assert!(
+            frame.to_rgb8() == on,
+            "{name}: the BVH's image differs from the octree's"
+        );
+        assert_eq!(c_on.rays, c_bvh.rays, "{name}: different rays were cast");
+        let brute_force_tests = scene.shapes.len() as u64 * c_bvh.rays.total();
+        assert!(
+            (1..=brute_force_tests).contains(&c_bvh.work.intersection_tests),
+            "{name}: the BVH counted {} tests, brute force would make {brute_force_tests}",
+            c_bvh.work.intersection_tests
+        );
     }
 }
 
@@ -91,12 +112,13 @@ proptest! {
     ) {
         let params = OctreeParams { max_depth, leaf_size, cost_driven: max_depth % 2 == 0, ..Default::default() };
         let octree = Octree::build(&shapes, params).unwrap();
+        let bvh = Bvh::build(&shapes);
         let is_transparent: Vec<bool> = (0..shapes.len()).map(|i| transparent_mask >> (i % 64) & 1 == 1).collect();
         // Some shapes one-sided (the SPD protocol's opaque surfaces).
         let one_sided: Vec<bool> = (0..shapes.len()).map(|i| one_sided_mask >> (i % 64) & 1 == 1).collect();
         let prims = Primitives { shapes: &shapes, one_sided: &one_sided, transparent: &is_transparent };
         for ray in rays {
-            agree(&octree, &prims, ray, shadow_length)?;
+            agree(&octree, &bvh, &prims, ray, shadow_length)?;
         }
     }
 
@@ -116,6 +138,7 @@ proptest! {
         transparent_mask in any::<u64>(),
     ) {
         let octree = Octree::build(&shapes, OctreeParams { leaf_size, ..Default::default() }).unwrap();
+        let bvh = Bvh::build(&shapes);
         let is_transparent: Vec<bool> = (0..shapes.len()).map(|i| transparent_mask >> (i % 64) & 1 == 1).collect();
         let prims = Primitives { shapes: &shapes, one_sided: &[], transparent: &is_transparent };
         for (ray, on, u, v) in rays {
@@ -129,16 +152,17 @@ proptest! {
                 }
                 _ => Ray::new(origin, ray.dir),
             };
-            agree(&octree, &prims, ray, 20.0 * scale)?;
+            agree(&octree, &bvh, &prims, ray, 20.0 * scale)?;
         }
     }
 }
 
 /// The octree's closest hit and shadow verdict for `ray`, by the walk that
 /// counts nothing (the wide walk) and by the one that counts (the exact
-/// walk Havran's measures come from), equal brute force's.
+/// walk Havran's measures come from), and the BVH's, equal brute force's.
 fn agree(
     octree: &Octree,
+    bvh: &Bvh,
     prims: &Primitives,
     ray: Ray,
     shadow_length: f64,
@@ -178,5 +202,23 @@ fn agree(
         &mut WorkCounts::default(),
     );
     prop_assert_eq!(&b, &t, "shadow verdict (counted) differs for {:?}", ray);
+    let mut bvh_stack = BvhStack::default();
+    let found = bvh.closest(
+        prims,
+        &prepared,
+        f64::INFINITY,
+        &mut bvh_stack,
+        &mut NoCounts,
+    );
+    prop_assert_eq!(brute, found, "the BVH's closest hit differs for {:?}", ray);
+    bvh.occlusion(
+        prims,
+        &prepared,
+        shadow_length,
+        &mut t,
+        &mut bvh_stack,
+        &mut WorkCounts::default(),
+    );
+    prop_assert_eq!(&b, &t, "the BVH's shadow verdict differs for {:?}", ray);
     Ok(())
 }

@@ -20,6 +20,48 @@ impl Switch {
     }
 }
 
+/// What ray queries go through, as `--accel` names it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum AccelArg {
+    /// The octree (glint's default).
+    Octree,
+    /// A bounding volume hierarchy (binned SAH), to compare with the octree.
+    Bvh,
+    /// Brute force: every shape for every ray.
+    None,
+}
+
+impl AccelArg {
+    /// `--accel` and the older `--octree on|off` together: either alone,
+    /// or both when they agree; `None` when neither is given (the scene's
+    /// setting).
+    pub fn resolve(accel: Option<AccelArg>, octree: Option<Switch>) -> Result<Option<AccelArg>> {
+        let from_switch = octree.map(|s| {
+            if s.is_on() {
+                AccelArg::Octree
+            } else {
+                AccelArg::None
+            }
+        });
+        match (accel, from_switch) {
+            (Some(a), Some(o)) if a != o => anyhow::bail!(
+                "--octree {} and --accel {} disagree: give one of them",
+                if o == AccelArg::Octree { "on" } else { "off" },
+                a.name()
+            ),
+            (a, o) => Ok(a.or(o)),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            AccelArg::Octree => "octree",
+            AccelArg::Bvh => "bvh",
+            AccelArg::None => "none",
+        }
+    }
+}
+
 pub use glint::report::median;
 
 /// Loads a scene and reports how long it took.

@@ -5,14 +5,14 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use glint::accel::Octree;
+use glint::accel::{Bvh, Octree};
 use glint::camera::CameraSpec;
 use glint::render::{FinishedTile, PassInfo, PassOptions, PassWatch, RenderedFrame, Renderer};
 use glint::settings::{Overrides, RenderSettings, ViewMode};
 
 use crate::common::{
-    OctreeArgs, RulesArgs, Switch, load_scene, parse_pixel, parse_positive, parse_samples,
-    thread_pool,
+    AccelArg, OctreeArgs, RulesArgs, Switch, load_scene, parse_pixel, parse_positive,
+    parse_samples, thread_pool,
 };
 
 #[derive(clap::Args)]
@@ -50,9 +50,15 @@ pub struct RenderArgs {
     pub max_depth: Option<u32>,
     #[command(flatten)]
     pub rules: RulesArgs,
-    /// Use the octree (default: the scene's setting, on unless it says otherwise).
+    /// Use the octree (default: the scene's setting, on unless it says
+    /// otherwise); `--accel` says the same and more.
     #[arg(long, value_enum)]
     pub octree: Option<Switch>,
+    /// What ray queries go through: the octree, a BVH (to compare: the
+    /// same image, other build and render times and work counts) or none
+    /// (brute force). Default: the scene's octree setting.
+    #[arg(long, value_enum)]
+    pub accel: Option<AccelArg>,
     #[command(flatten)]
     pub octree_params: OctreeArgs,
     /// Render threads (default: one per core; at most 8 per core).
@@ -110,12 +116,28 @@ struct Prepared {
     settings: RenderSettings,
     camera: CameraSpec,
     octree: Octree,
+    /// Built with `--accel bvh`: then it answers every query.
+    bvh: Option<glint::accel::Bvh>,
     overlay_depth: Option<u32>,
     legend: bool,
     threads: usize,
     pool: rayon::ThreadPool,
     load_s: f64,
     build_s: f64,
+}
+
+impl Prepared {
+    /// The renderer of this job with `settings`, through its BVH if it has one.
+    fn renderer(
+        &self,
+        settings: RenderSettings,
+    ) -> Result<Renderer<'_>, glint::render::RenderError> {
+        let renderer = Renderer::with_camera(&self.scene, &self.octree, settings, &self.camera)?;
+        Ok(match &self.bvh {
+            Some(bvh) => renderer.with_bvh(bvh),
+            None => renderer,
+        })
+    }
 }
 
 pub fn run(args: &RenderArgs) -> Result<()> {
@@ -166,6 +188,7 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
             .unwrap_or(glint::limits::DEFAULT_OVERLAY_DEPTH)
     });
     let mut legend = true;
+    let mut recorded_bvh = false;
     let (mut scene, scene_name, mut settings, camera) = match (&args.from_png, &args.scene) {
         (Some(png), _) => {
             let restored = glint::export::restore(png)
@@ -178,6 +201,7 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
                 .map(|d| args.overlay_depth.unwrap_or(d))
                 .or(overlay_depth);
             legend = restored.legend;
+            recorded_bvh = restored.bvh;
             (
                 restored.scene,
                 restored.scene_path,
@@ -197,7 +221,13 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
     if let Some(switch) = args.legend {
         legend = switch.is_on();
     }
-    overrides(args).apply(&mut settings, &mut scene.octree_params);
+    let accel =
+        AccelArg::resolve(args.accel, args.octree)?.or(recorded_bvh.then_some(AccelArg::Bvh));
+    let mut overrides = overrides(args);
+    if let Some(a) = accel {
+        overrides.use_octree = Some(a == AccelArg::Octree);
+    }
+    overrides.apply(&mut settings, &mut scene.octree_params);
 
     let pool = thread_pool(args.threads)?;
     let threads = pool.current_num_threads();
@@ -214,12 +244,15 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
     } else {
         Octree::build(&[], scene.octree_params)?
     };
+    let bvh = (accel == Some(AccelArg::Bvh)).then(|| pool.install(|| Bvh::build(&scene.shapes)));
     let build_s = build_start.elapsed().as_secs_f64();
     if args.output.is_some() {
         // Validate before starting.
         Renderer::with_camera(&scene, &octree, settings, &camera)
             .with_context(|| format!("cannot render {scene_name}"))?;
-        glint::render::memory::check_memory(&settings, octree.stats().memory_bytes)
+        let accel_bytes =
+            octree.stats().memory_bytes + bvh.as_ref().map_or(0, |b| b.stats().memory_bytes);
+        glint::render::memory::check_memory(&settings, accel_bytes)
             .with_context(|| format!("cannot render {scene_name}"))?;
     }
     Ok(Prepared {
@@ -228,6 +261,7 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
         settings,
         camera,
         octree,
+        bvh,
         overlay_depth,
         legend,
         threads,
@@ -256,7 +290,8 @@ fn overrides(args: &RenderArgs) -> Overrides {
 /// Renders every pass of the frame with a progress bar on a terminal;
 /// returns it and the seconds it took.
 fn render(job: &Prepared, count_work: bool) -> Result<(RenderedFrame, f64)> {
-    let renderer = Renderer::with_camera(&job.scene, &job.octree, job.settings, &job.camera)
+    let renderer = job
+        .renderer(job.settings)
         .with_context(|| format!("cannot render {}", job.scene_name))?;
     let bar = std::io::stderr().is_terminal().then(|| {
         let bar = indicatif::ProgressBar::new(1);
@@ -309,6 +344,7 @@ fn save(
     let s = &job.settings;
     let mut record = glint::export::render_record(&job.scene, &job.scene_name, &job.camera, *s);
     record.settings.legend = job.legend;
+    record.settings.bvh = job.bvh.is_some();
     let camera = glint::camera::Camera::new(&job.camera, s.width, s.height)?;
     let overlay = job
         .overlay_depth
@@ -347,7 +383,7 @@ fn report(
             _ => String::new(),
         };
         say!(
-            "wrote {} ({}x{}{written}) in {:.2} s: load {:.2} s, octree build {:.2} s, render {:.2} s, write {:.2} s",
+            "wrote {} ({}x{}{written}) in {:.2} s: load {:.2} s, {} build {:.2} s, render {:.2} s, write {:.2} s",
             if output.as_os_str() == "-" {
                 "standard output".to_string()
             } else {
@@ -357,6 +393,7 @@ fn report(
             height,
             job.load_s + job.build_s + render_s + write_s,
             job.load_s,
+            if job.bvh.is_some() { "BVH" } else { "octree" },
             job.build_s,
             render_s,
             write_s
@@ -398,6 +435,10 @@ fn report(
         rendered,
         times,
     );
+    let stats = match &job.bvh {
+        Some(bvh) => stats.with_bvh(bvh.stats()),
+        None => stats,
+    };
     out!("{}", serde_json::to_string_pretty(&stats)?)?;
     Ok(())
 }
@@ -414,7 +455,8 @@ fn print_ray_tree(job: &Prepared, x: u32, y: u32) -> Result<()> {
             height: settings.height
         }
     );
-    let renderer = Renderer::with_camera(&job.scene, &job.octree, settings, &job.camera)
+    let renderer = job
+        .renderer(settings)
         .with_context(|| format!("cannot render {}", job.scene_name))?;
     let out = glint::report::TraceReport::new(&renderer, &job.scene, &job.scene_name, x, y)?;
     out!("{}", serde_json::to_string_pretty(&out)?)?;
