@@ -453,6 +453,7 @@ impl PyScene {
             repeat,
             brute_force_budget,
             octree_only,
+            bvh: false,
         };
         let stop = AtomicBool::new(false);
         let result = run_stoppable(slf.py(), cancel, &stop, || {

@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::accel::{OctreeError, OctreeParams, OctreeStats};
+use crate::accel::{Bvh, BvhStats, OctreeError, OctreeParams, OctreeStats};
 use crate::render::{Prediction, RenderError, Renderer, UnitCosts, sample_rays};
 use crate::scene::Scene;
 use crate::settings::{Protocol, RenderSettings};
@@ -53,6 +53,9 @@ pub struct SceneBench {
     pub unit_costs: UnitCosts,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub octree_off: Option<Timing>,
+    /// With `--accel bvh`: the same render through a BVH.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bvh: Option<BvhBench>,
     /// Brute force time over octree time, measured on the same rays.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub speedup: Option<f64>,
@@ -74,6 +77,16 @@ pub struct SceneBench {
 }
 
 /// How a scene is benchmarked, besides its render settings.
+/// A BVH's figures beside the octree's: its build (median of the
+/// repeats), what it made, and its render's time and work counts.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct BvhBench {
+    pub build_s: f64,
+    pub bvh_stats: BvhStats,
+    #[serde(flatten)]
+    pub timing: Timing,
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BenchOptions {
     /// Timed runs of each configuration (at least 1); medians are reported.
@@ -83,6 +96,8 @@ pub struct BenchOptions {
     pub brute_force_budget: f64,
     /// Time the octree only: no brute-force comparison.
     pub octree_only: bool,
+    /// Also time the render through a BVH ([`SceneBench::bvh`]).
+    pub bvh: bool,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -183,8 +198,26 @@ pub fn bench_scene(
         use_octree: false,
         ..settings
     };
+    let mut bvh_build_times = Vec::new();
+    let mut bvh = None;
+    if options.bvh {
+        for _ in 0..options.repeat {
+            check()?;
+            let (tree, s) = timed(|| pool.install(|| Bvh::build(&scene.shapes)));
+            bvh_build_times.push(s);
+            bvh = Some(tree);
+        }
+    }
     let renderer_on = Renderer::new(scene, &octree, on)?;
     let renderer_off = Renderer::new(scene, &octree, off)?;
+    let renderer_bvh = bvh
+        .as_ref()
+        .map(|b| Renderer::new(scene, &octree, off).map(|r| r.with_bvh(b)))
+        .transpose()?;
+    check()?;
+    let counted_bvh = renderer_bvh
+        .as_ref()
+        .map(|r| pool.install(|| r.render(true, None).1));
     let unit_costs = UnitCosts::measure(&renderer_on, &octree)?;
     let ray_sample = sample_rays(&renderer_on, &octree)?;
 
@@ -218,6 +251,7 @@ pub fn bench_scene(
 
     // Timed passes, interleaved so drift in machine speed hits both alike.
     let (mut full_on, mut rows_on, mut rows_off) = (Vec::new(), Vec::new(), Vec::new());
+    let mut full_bvh = Vec::new();
     let mut counted_times = vec![counted_s];
     let repeats_started = Instant::now();
     for r in 0..options.repeat {
@@ -234,6 +268,10 @@ pub fn bench_scene(
         }
         check()?;
         full_on.push(timed(|| pool.install(|| renderer_on.render(false, None))).1);
+        if let Some(renderer) = &renderer_bvh {
+            check()?;
+            full_bvh.push(timed(|| pool.install(|| renderer.render(false, None))).1);
+        }
         if r > 0 {
             check()?;
             counted_times.push(timed(|| pool.install(|| renderer_on.render(true, None))).1);
@@ -295,6 +333,14 @@ pub fn bench_scene(
                     c.rays.total() as f64,
                     every > 1,
                 )
+            }),
+        bvh: bvh
+            .as_ref()
+            .zip(counted_bvh.as_ref())
+            .map(|(b, c)| BvhBench {
+                build_s: median(bvh_build_times.clone()),
+                bvh_stats: b.stats(),
+                timing: timing(c, median(full_bvh.clone()), c.rays.total() as f64, false),
             }),
         speedup,
         compared_rows_every: every,

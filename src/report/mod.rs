@@ -10,7 +10,8 @@ mod render_stats;
 mod trace;
 
 pub use bench::{
-    BenchError, BenchOptions, BenchWatch, SceneBench, Timing, bench_scene, duration_text, median,
+    BenchError, BenchOptions, BenchWatch, BvhBench, SceneBench, Timing, bench_scene, duration_text,
+    median,
 };
 pub use render_stats::{CostJson, RaysJson, RenderStats, RenderTimes};
 pub use trace::{LightJson, PixelOutside, TraceReport, trace_settings};

@@ -141,3 +141,39 @@ fn accel_and_octree_flags_that_disagree_are_refused() {
     ]);
     assert!(out.status.success());
 }
+
+#[test]
+fn bench_times_a_bvh_beside_the_octree_when_asked() {
+    let scene = common::repo_path("scenes/glass.toml");
+    let scene = scene.to_str().unwrap();
+    let bench = |accel: &str| {
+        glint(&[
+            "bench", scene, "--size", "32x24", "--repeat", "1", "--format", "json", "--accel",
+            accel,
+        ])
+    };
+    let json = |out: std::process::Output| -> serde_json::Value {
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()[0].clone()
+    };
+    let with = json(bench("octree,bvh"));
+    let bvh = &with["bvh"];
+    assert!(bvh["build_s"].as_f64().unwrap() >= 0.0);
+    assert!(bvh["render_s"].as_f64().unwrap() > 0.0);
+    assert!(bvh["intersection_tests_per_ray"].as_f64().unwrap() > 0.0);
+    assert!(bvh["bvh_stats"]["nodes"].as_u64().unwrap() >= 1);
+    assert!(
+        with.get("octree_off").is_none(),
+        "brute force was not asked for"
+    );
+    let plain = json(bench("octree,none"));
+    assert!(plain.get("bvh").is_none());
+    assert!(plain["octree_off"].is_object());
+    let refused = bench("bvh");
+    assert_eq!(refused.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("always times the octree"));
+}

@@ -11,8 +11,8 @@ use glint::settings::{Overrides, RenderSettings};
 use serde::Serialize;
 
 use crate::common::{
-    OctreeArgs, RulesArgs, check_scene_files, load_scene, median, parse_positive, parse_samples,
-    parse_size, thread_pool,
+    AccelArg, OctreeArgs, RulesArgs, check_scene_files, load_scene, median, parse_positive,
+    parse_samples, parse_size, thread_pool,
 };
 
 #[derive(clap::Args)]
@@ -55,6 +55,12 @@ pub struct BenchArgs {
     /// `speedup` are then left out of the JSON).
     #[arg(long)]
     pub octree_only: bool,
+    /// What to time, comma-separated: the octree always, and beside it
+    /// `none` (brute force, the default) and `bvh` (a BVH: its build,
+    /// memory, work counts and render in a `bvh` object and a second
+    /// table). `--accel octree` alone is `--octree-only`.
+    #[arg(long, value_delimiter = ',', value_enum, default_value = "octree,none")]
+    pub accel: Vec<AccelArg>,
     /// What the image shows (default: shaded); `normals` and `depth`
     /// trace eye rays only.
     #[arg(long, value_parser = |s: &str| s.parse::<glint::settings::ViewMode>())]
@@ -98,6 +104,14 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
 
 pub fn run(args: &BenchArgs) -> Result<()> {
     args.rules.check(args.max_depth, args.samples)?;
+    anyhow::ensure!(
+        args.accel.contains(&AccelArg::Octree),
+        "glint bench always times the octree: list it in --accel (e.g. --accel octree,bvh)"
+    );
+    anyhow::ensure!(
+        !args.sweep || !args.accel.contains(&AccelArg::Bvh),
+        "--sweep varies the octree's parameters; --accel bvh goes with a plain bench"
+    );
     check_scene_files(&args.scenes)?;
     if args.sweep {
         return sweep(args);
@@ -120,7 +134,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let options = glint::report::BenchOptions {
             repeat: args.repeat,
             brute_force_budget: args.brute_force_budget,
-            octree_only: args.octree_only,
+            octree_only: args.octree_only || !args.accel.contains(&AccelArg::None),
+            bvh: args.accel.contains(&AccelArg::Bvh),
         };
         let name = path.display().to_string();
         results.push(glint::report::bench_scene(
@@ -140,6 +155,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             if results.iter().any(|r| r.published.is_some()) {
                 out_str!("\n{}", counts_markdown(&results))?;
             }
+            if results.iter().any(|r| r.bvh.is_some()) {
+                out_str!("\n{}", bvh_markdown(&results))?;
+            }
         }
     }
     Ok(())
@@ -158,6 +176,36 @@ impl glint::report::BenchWatch for SayProgress {
 fn stem(path: &std::path::Path) -> String {
     path.file_stem()
         .map_or(String::new(), |s| s.to_string_lossy().into_owned())
+}
+
+/// The octree beside the BVH (`--accel bvh`): build, memory, work per ray
+/// and render time of each.
+fn bvh_markdown(results: &[SceneBench]) -> String {
+    let mut s = String::from(
+        "| scene | build octree (s) | build BVH (s) | octree MiB | BVH MiB | steps/ray octree | steps/ray BVH | tests/ray octree | tests/ray BVH | render octree (s) | render BVH (s) |\n\
+         |---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+    );
+    let mib = |bytes: u64| bytes as f64 / (1u64 << 20) as f64;
+    for r in results {
+        let Some(b) = &r.bvh else { continue };
+        let name = std::path::Path::new(&r.scene)
+            .file_name()
+            .map_or(r.scene.clone(), |n| n.to_string_lossy().into_owned());
+        s.push_str(&format!(
+            "| {name} | {:.3} | {:.3} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.3} | {:.3} |\n",
+            r.build_s,
+            b.build_s,
+            mib(r.octree_stats.memory_bytes),
+            mib(b.bvh_stats.memory_bytes),
+            r.octree_on.traversal_steps_per_ray,
+            b.timing.traversal_steps_per_ray,
+            r.octree_on.intersection_tests_per_ray,
+            b.timing.intersection_tests_per_ray,
+            r.octree_on.render_s,
+            b.timing.render_s,
+        ));
+    }
+    s
 }
 
 fn markdown(results: &[SceneBench]) -> String {
