@@ -126,6 +126,31 @@ impl std::str::FromStr for Protocol {
     }
 }
 
+/// What ray queries go through. Each answers exactly alike (the image is
+/// the same); build time, memory and render time differ.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Accel {
+    /// The octree, glint's default.
+    Octree,
+    /// A bounding volume hierarchy ([`crate::accel::Bvh`]), to compare.
+    Bvh,
+    /// Every shape for every ray.
+    BruteForce,
+}
+
+impl Accel {
+    pub const ALL: [Accel; 3] = [Accel::Octree, Accel::Bvh, Accel::BruteForce];
+
+    /// As `--accel` and the statistics name it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Accel::Octree => "octree",
+            Accel::Bvh => "bvh",
+            Accel::BruteForce => "none",
+        }
+    }
+}
+
 /// Everything that decides the image besides the scene; the command line
 /// and the viewer override the scene's own values.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -154,6 +179,11 @@ pub struct RenderSettings {
     /// every light then reaches every point that faces it).
     #[serde(default = "yes", skip_serializing_if = "Clone::clone")]
     pub shadows: bool,
+    /// Ray queries through a BVH ([`Accel::Bvh`]; `use_octree` is then
+    /// false). Set both through [`RenderSettings::set_accel`]. Absent from
+    /// records when false, as in those from before it.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub bvh: bool,
 }
 
 fn yes() -> bool {
@@ -166,6 +196,21 @@ impl RenderSettings {
         crate::limits::check_image_size(self.width, self.height)?;
         crate::limits::check_samples(self.samples)?;
         crate::limits::check_max_depth(self.max_depth)
+    }
+
+    /// What these settings' ray queries go through.
+    pub fn accel(&self) -> Accel {
+        match (self.bvh, self.use_octree) {
+            (true, _) => Accel::Bvh,
+            (false, true) => Accel::Octree,
+            (false, false) => Accel::BruteForce,
+        }
+    }
+
+    /// Sets what ray queries go through (`use_octree` and `bvh` together).
+    pub fn set_accel(&mut self, accel: Accel) {
+        self.use_octree = accel == Accel::Octree;
+        self.bvh = accel == Accel::Bvh;
     }
 
     /// The anti-aliasing these settings ask for.
@@ -309,7 +354,9 @@ pub struct Overrides {
     pub height: Option<u32>,
     pub anti_aliasing: Option<AntiAliasing>,
     pub max_depth: Option<u32>,
+    /// The octree on or off (`--octree`); [`Overrides::accel`] wins.
     pub use_octree: Option<bool>,
+    pub accel: Option<Accel>,
     pub octree: OctreeOverrides,
     pub view: Option<ViewMode>,
     /// Applied before colours and sides: it sets its own depth and sidedness.
@@ -367,7 +414,10 @@ impl Overrides {
             settings.max_depth = d;
         }
         if let Some(o) = self.use_octree {
-            settings.use_octree = o;
+            settings.set_accel(if o { Accel::Octree } else { Accel::BruteForce });
+        }
+        if let Some(a) = self.accel {
+            settings.set_accel(a);
         }
         self.octree.apply(params);
         if let Some(v) = self.view {
@@ -402,7 +452,39 @@ mod tests {
             sides: Sides::Two,
             adaptive: false,
             shadows: true,
+            bvh: false,
         }
+    }
+
+    #[test]
+    fn the_accelerator_is_one_of_three_whichever_override_sets_it() {
+        let mut settings = base();
+        assert_eq!(settings.accel(), Accel::Octree);
+        let mut params = OctreeParams::default();
+        for accel in Accel::ALL {
+            settings.set_accel(accel);
+            assert_eq!(settings.accel(), accel);
+            assert_eq!(settings.use_octree, accel == Accel::Octree);
+            // `--octree on|off` over a BVH render replaces it.
+            for on in [true, false] {
+                let mut s = settings;
+                Overrides {
+                    use_octree: Some(on),
+                    ..Overrides::default()
+                }
+                .apply(&mut s, &mut params);
+                assert_eq!(
+                    s.accel(),
+                    if on { Accel::Octree } else { Accel::BruteForce }
+                );
+            }
+        }
+        // Records from before the BVH read as they were written.
+        let mut old = serde_json::to_value(base()).unwrap();
+        assert!(old.get("bvh").is_none(), "absent when false");
+        old["use_octree"] = false.into();
+        let read: RenderSettings = serde_json::from_value(old).unwrap();
+        assert_eq!(read.accel(), Accel::BruteForce);
     }
 
     #[test]

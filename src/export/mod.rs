@@ -129,8 +129,6 @@ pub struct Restored {
     pub overlay_depth: Option<u32>,
     /// Whether the legend strip is drawn (diagnostic views, the overlay).
     pub legend: bool,
-    /// Rendered through a BVH.
-    pub bvh: bool,
     /// Notes for the user: another glint version, a partial export.
     pub notes: Vec<String>,
 }
@@ -177,7 +175,6 @@ pub fn restore(png: &Path) -> Result<Restored, ExportError> {
         camera: record.settings.camera.into(),
         overlay_depth: record.settings.overlay_depth,
         legend: record.settings.legend,
-        bvh: record.settings.bvh,
         notes,
     })
 }

@@ -64,11 +64,7 @@ pub struct RecordedSettings {
     /// in records from before the flag: they all have it.
     #[serde(default = "legend_default", skip_serializing_if = "is_true")]
     pub legend: bool,
-    /// Rendered through a BVH (`glint render --accel bvh`; `use_octree` is
-    /// then false): a re-render builds one again rather than testing every
-    /// shape. Absent otherwise.
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    pub bvh: bool,
+
     /// The files besides the scene text it was built from (meshes, MTL
     /// libraries: not embedded) with their SHA-256, so a re-render can say
     /// when one has changed. Absent in records from before it.
@@ -159,7 +155,6 @@ impl RenderRecord {
                 edits: None,
                 partial: false,
                 legend: true,
-                bvh: false,
                 files: scene
                     .files_read
                     .iter()

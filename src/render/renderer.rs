@@ -13,7 +13,7 @@ use crate::material::Material;
 use crate::math::Color;
 use crate::render::ray_tree::{RayKind, RayNode};
 use crate::scene::Scene;
-use crate::settings::{RenderSettings, Sides, ViewMode};
+use crate::settings::{Accel, RenderSettings, Sides, ViewMode};
 use crate::shapes::PreparedRay;
 use crate::simd::{SimdLevel, SingleRays};
 use crate::stats::{Counter, NoCounts, RayCounts};
@@ -244,18 +244,24 @@ impl<'a> Renderer<'a> {
         self.simd
     }
 
-    /// Renders through `bvh` (built over this scene's shapes) instead of
-    /// the octree or brute force, whatever `use_octree` says: the bytes
-    /// are the same, only the time and the work counted differ. Its rays go
-    /// one at a time (the packet walks are the octree's).
+    /// The BVH (built over this scene's shapes) that queries go through
+    /// when the settings ask for one ([`Accel::Bvh`]); without it they
+    /// test every shape. The bytes are the same either way, only the time
+    /// and the work counted differ. Its rays go one at a time (the packet
+    /// walks are the octree's).
     pub fn with_bvh(mut self, bvh: &'a Bvh) -> Self {
         self.bvh = Some(bvh);
         self
     }
 
+    /// The BVH queries go through, if the settings ask for one and it was given.
+    fn bvh(&self) -> Option<&'a Bvh> {
+        self.bvh.filter(|_| self.settings.accel() == Accel::Bvh)
+    }
+
     /// Whether eye rays go through the octree's packet walk.
     pub(super) fn packets_through_octree(&self) -> bool {
-        self.settings.use_octree && self.bvh.is_none()
+        self.settings.accel() == Accel::Octree
     }
 
     pub(super) fn primitives(&self) -> Primitives<'_> {
@@ -272,7 +278,7 @@ impl<'a> Renderer<'a> {
         query: &mut Query<C>,
     ) -> Option<ClosestHit> {
         let prims = self.primitives();
-        if let Some(bvh) = self.bvh {
+        if let Some(bvh) = self.bvh() {
             return bvh.closest(
                 &prims,
                 ray,
@@ -323,7 +329,7 @@ impl<'a> Renderer<'a> {
             bvh,
             crossings,
         } = &mut *query.scratch;
-        if let Some(tree) = self.bvh {
+        if let Some(tree) = self.bvh() {
             tree.occlusion(&prims, ray, distance, crossings, bvh, query.counter);
         } else if self.settings.use_octree {
             match self.single_rays.avx2() {

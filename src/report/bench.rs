@@ -9,7 +9,7 @@ use serde::Serialize;
 use crate::accel::{Bvh, BvhStats, OctreeError, OctreeParams, OctreeStats};
 use crate::render::{Prediction, RenderError, Renderer, UnitCosts, sample_rays};
 use crate::scene::Scene;
-use crate::settings::{Protocol, RenderSettings};
+use crate::settings::{Accel, Protocol, RenderSettings};
 use crate::simd::SimdLevel;
 use crate::stats::published::SpdCounts;
 use crate::stats::{RayCounts, RenderCounts};
@@ -190,14 +190,12 @@ pub fn bench_scene(
         return Err(BenchError::NoRepeats);
     };
 
-    let on = RenderSettings {
-        use_octree: true,
-        ..settings
+    let through = |accel| {
+        let mut s = settings;
+        s.set_accel(accel);
+        s
     };
-    let off = RenderSettings {
-        use_octree: false,
-        ..settings
-    };
+    let (on, off) = (through(Accel::Octree), through(Accel::BruteForce));
     let mut bvh_build_times = Vec::new();
     let mut bvh = None;
     if options.bvh {
@@ -212,7 +210,7 @@ pub fn bench_scene(
     let renderer_off = Renderer::new(scene, &octree, off)?;
     let renderer_bvh = bvh
         .as_ref()
-        .map(|b| Renderer::new(scene, &octree, off).map(|r| r.with_bvh(b)))
+        .map(|b| Renderer::new(scene, &octree, through(Accel::Bvh)).map(|r| r.with_bvh(b)))
         .transpose()?;
     check()?;
     let counted_bvh = renderer_bvh

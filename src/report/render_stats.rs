@@ -9,7 +9,7 @@ use crate::accel::{BvhStats, Octree, OctreeParams, OctreeStats};
 use crate::color::ColorConvention;
 use crate::render::RenderedFrame;
 use crate::scene::{DroppedPolygons, MeshCounts, Scene, SkippedElements};
-use crate::settings::{AntiAliasing, Protocol, RenderSettings, Sides, ViewMode};
+use crate::settings::{Accel, AntiAliasing, Protocol, RenderSettings, Sides, ViewMode};
 use crate::stats::RayCounts;
 
 /// The `--stats` object. Its field names are a public interface: add
@@ -124,12 +124,8 @@ impl RenderStats {
             samples: settings.samples,
             max_depth: settings.max_depth,
             threads,
-            octree: settings.use_octree,
-            accel: if settings.use_octree {
-                "octree"
-            } else {
-                "none"
-            },
+            octree: settings.accel() == Accel::Octree,
+            accel: settings.accel().name(),
             octree_params: scene.octree_params,
             view: settings.view,
             protocol: settings.protocol,
@@ -164,7 +160,7 @@ impl RenderStats {
             skipped_elements: scene.skipped_elements.clone(),
             not_rendered: scene.not_rendered.clone(),
             load_notes: scene.load_notes.clone(),
-            octree_stats: settings.use_octree.then(|| octree.stats()),
+            octree_stats: (settings.accel() == Accel::Octree).then(|| octree.stats()),
             bvh_stats: None,
             cost_per_pixel: frame.cost_summary().map(|c| CostJson {
                 min: c.min,
@@ -174,12 +170,9 @@ impl RenderStats {
         }
     }
 
-    /// The statistics of a render through a BVH (the octree off).
+    /// With the statistics of the BVH the render went through.
     pub fn with_bvh(self, stats: BvhStats) -> Self {
         Self {
-            octree: false,
-            accel: "bvh",
-            octree_stats: None,
             bvh_stats: Some(stats),
             ..self
         }

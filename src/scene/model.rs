@@ -153,6 +153,7 @@ impl Scene {
             sides: self.image.sides,
             adaptive: self.image.adaptive,
             shadows: true,
+            bvh: false,
         }
     }
 

@@ -110,6 +110,9 @@ pub struct GlintApp {
     // is on screen.
     octree: Arc<Octree>,
     build_seconds: f64,
+    /// The BVH, built the first time the accelerator choice asks for it
+    /// (and again for other geometry).
+    bvh: Option<octree_tuning::BuiltBvh>,
     /// What a traversal step, an intersection test and the rest of a ray
     /// cost here, measured on the scene when it was installed: they turn
     /// the octree's predicted work into a predicted time.
@@ -179,6 +182,7 @@ impl GlintApp {
             magnification: Magnification::default(),
             octree: Arc::new(octree),
             build_seconds,
+            bvh: None,
             unit_costs: None,
             suggestion: None,
             ray_sample: None,
@@ -392,6 +396,7 @@ impl GlintApp {
             worker: &self.worker,
             octree: &self.octree,
             build_seconds: self.build_seconds,
+            bvh: self.bvh.as_ref().map(|b| (&*b.tree, b.seconds)),
             last_preview: self.last_preview,
             message: self.messages.last(),
         };
@@ -630,9 +635,12 @@ impl GlintApp {
         if self.submitted.as_ref() == Some(&inputs) {
             return;
         }
+        let bvh = self.bvh_if_chosen();
+        let edit = &self.edit;
         let job = Job {
             scene: Arc::clone(&edit.scene),
             octree: Arc::clone(&self.octree),
+            bvh,
             camera: edit.camera,
             settings: edit.settings,
             preview: inputs.preview,

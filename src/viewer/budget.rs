@@ -142,7 +142,7 @@ mod tests {
                 refraction: 10,
                 total_internal_reflections: 0,
             },
-            octree: true,
+            accel: crate::settings::Accel::Octree,
             anti_aliasing: false,
             width: 800,
             height: 600,
@@ -169,6 +169,7 @@ mod tests {
             sides: crate::settings::Sides::Two,
             adaptive: false,
             shadows: true,
+            bvh: false,
         }
     }
 

@@ -325,7 +325,7 @@ mod tests {
             kind,
             seconds,
             rays: RayCounts::default(),
-            octree: true,
+            accel: crate::settings::Accel::Octree,
             anti_aliasing: true,
             width: 8,
             height: 8,

@@ -255,7 +255,10 @@ pub fn octree_ui(params: OctreeParams, info: &OctreeInfo, ui: &mut egui::Ui) -> 
                 total(p)
             ),
         });
-        if let Some(pass) = info.last_pass.filter(|p| p.octree && !p.from_cache) {
+        if let Some(pass) = info
+            .last_pass
+            .filter(|p| p.accel == crate::settings::Accel::Octree && !p.from_cache)
+        {
             ui.label(format!("Measured, the last {kind}: {:.2} s", pass.seconds));
         }
     }

@@ -12,7 +12,7 @@ use super::worker::{Preview, Worker};
 use crate::accel::Octree;
 use crate::color::ColorConvention;
 use crate::math::DVec3;
-use crate::settings::{AntiAliasing, Protocol, Sides, ViewMode};
+use crate::settings::{Accel, AntiAliasing, Protocol, Sides, ViewMode};
 
 /// A message shown in the status bar.
 #[derive(Clone, Debug)]
@@ -26,6 +26,8 @@ pub struct RenderInfo<'a> {
     pub worker: &'a Worker,
     pub octree: &'a Octree,
     pub build_seconds: f64,
+    /// The BVH and its build's seconds, once one was asked for.
+    pub bvh: Option<(&'a crate::accel::Bvh, f64)>,
     /// The preview chosen for the last drag, and its estimated seconds.
     pub last_preview: Option<(Preview, f64)>,
     pub message: Option<&'a Message>,
@@ -210,7 +212,21 @@ fn render_settings_ui(edit: &mut EditState, ui: &mut egui::Ui) {
         "trace every pixel's centre, then the 4x4 grid only where neighbours differ: \
              another material, a shadow edge, a visible contrast",
     );
-    ui.checkbox(&mut edit.settings.use_octree, "Octree");
+    ui.horizontal(|ui| {
+        ui.label("Accelerator");
+        let mut accel = edit.settings.accel();
+        for (choice, label, hover) in [
+            (Accel::Octree, "Octree", "the octree: glint's default, and what the overlay and walk views show"),
+            (Accel::Bvh, "BVH", "a bounding volume hierarchy, to compare: the same image, other build and render times"),
+            (Accel::BruteForce, "None", "no accelerator: every ray tests every shape"),
+        ] {
+            ui.selectable_value(&mut accel, choice, label)
+                .on_hover_text(hover);
+        }
+        if accel != edit.settings.accel() {
+            edit.settings.set_accel(accel);
+        }
+    });
     ui.horizontal(|ui| {
         ui.label("Max depth");
         ui.add_enabled(

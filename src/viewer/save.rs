@@ -163,9 +163,12 @@ fn edited_only(edit: &EditState, baseline: &Snapshot) -> (RenderSettings, Octree
     if now.sides == was.sides {
         s.sides = file.sides;
     }
-    if now.use_octree == was.use_octree {
+    // A scene file says the octree is on or off; the BVH is the viewer's
+    // (and a PNG record's) to choose, so choosing it keeps the file's switch.
+    if now.use_octree == was.use_octree || now.bvh {
         s.use_octree = file.use_octree;
     }
+    s.bvh = false;
     let (file, was, now) = (
         &edit.loaded.octree_params,
         &baseline.octree,

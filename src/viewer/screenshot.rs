@@ -51,13 +51,17 @@ impl Screenshot {
             for r in &passes {
                 let _ = writeln!(
                     std::io::stderr().lock(),
-                    "glint: {} pass {}x{}: {:.3} s, {:.2} Mrays/s, octree {}",
+                    "glint: {} pass {}x{}: {:.3} s, {:.2} Mrays/s, {}",
                     r.kind.label(),
                     r.width,
                     r.height,
                     r.seconds,
                     r.rays.total() as f64 / r.seconds.max(1e-9) / 1e6,
-                    if r.octree { "on" } else { "off" }
+                    match r.accel {
+                        crate::settings::Accel::Octree => "octree on",
+                        crate::settings::Accel::Bvh => "octree off, BVH",
+                        crate::settings::Accel::BruteForce => "octree off",
+                    }
                 );
             }
         }

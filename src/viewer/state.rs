@@ -9,7 +9,7 @@ use crate::accel::OctreeParams;
 use crate::camera::CameraSpec;
 use crate::material::{Light, Material};
 use crate::scene::Scene;
-use crate::settings::RenderSettings;
+use crate::settings::{Accel, RenderSettings};
 
 /// A setting `--compare` flips for the A image.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -159,6 +159,7 @@ impl Snapshot {
                 r.colors,
                 r.sides,
                 r.use_octree,
+                r.bvh,
             )
         };
         self.camera != other.camera
@@ -208,7 +209,11 @@ impl EditState {
     pub fn flip(&mut self, setting: CompareSetting) {
         let s = &mut self.settings;
         match setting {
-            CompareSetting::Octree => s.use_octree = !s.use_octree,
+            CompareSetting::Octree => s.set_accel(if s.accel() == Accel::Octree {
+                Accel::BruteForce
+            } else {
+                Accel::Octree
+            }),
             CompareSetting::AntiAliasing => {
                 s.samples = if s.samples > 1 {
                     1
@@ -223,10 +228,14 @@ impl EditState {
     pub fn settings_label(&self) -> String {
         let s = &self.settings;
         format!(
-            "{}, AA {}, octree {}, depth {}, {}x{}",
+            "{}, AA {}, {}, depth {}, {}x{}",
             s.view.name(),
             s.anti_aliasing().name(),
-            if s.use_octree { "on" } else { "off" },
+            match s.accel() {
+                Accel::Octree => "octree on",
+                Accel::Bvh => "BVH",
+                Accel::BruteForce => "octree off",
+            },
             s.max_depth,
             s.width,
             s.height

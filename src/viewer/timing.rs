@@ -10,7 +10,7 @@ use super::panels::RenderInfo;
 use super::state::EditState;
 use super::worker::{PassRecord, ShownPass, Worker};
 use crate::render::PassKind as Engine;
-use crate::settings::ViewMode;
+use crate::settings::{Accel, ViewMode};
 
 /// Pass times and ray counts, the octree's figures, the view's legend and
 /// the inspected pixel's ray tree.
@@ -208,7 +208,18 @@ fn timing_grid_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
                 row("rays: reflection", format!("{}", r.rays.reflection));
                 row("rays: refraction", format!("{}", r.rays.refraction));
             }
-            if edit.settings.use_octree {
+            if let (Accel::Bvh, Some((bvh, seconds))) = (edit.settings.accel(), info.bvh) {
+                let stats = bvh.stats();
+                row("BVH build", format!("{seconds:.3} s"));
+                row(
+                    "BVH nodes",
+                    format!("{} ({} leaves)", stats.nodes, stats.leaves),
+                );
+                row(
+                    "BVH memory",
+                    format!("{:.1} KiB", stats.memory_bytes as f64 / 1024.0),
+                );
+            } else if edit.settings.use_octree {
                 let stats = info.octree.stats();
                 row("octree build", format!("{:.3} s", info.build_seconds));
                 row(
@@ -269,7 +280,7 @@ fn time_tick_label(value: f64, step: f64, right_edge: f64) -> String {
 /// 16 samples, SPD corners), octree setting and view are comparable.
 #[derive(Clone, Copy, PartialEq)]
 struct SeriesKey {
-    octree: bool,
+    accel: Accel,
     /// The full pass (adaptive refinement counted with the full grid: the
     /// same anti-aliasing, as a user sees it).
     kind: Engine,
@@ -279,7 +290,7 @@ struct SeriesKey {
 impl SeriesKey {
     fn of(r: &PassRecord) -> Self {
         Self {
-            octree: r.octree,
+            accel: r.accel,
             kind: if r.kind.is_grid() {
                 Engine::Grid
             } else {
@@ -296,7 +307,12 @@ impl SeriesKey {
             Engine::Corners => "SPD corners",
             Engine::OneSample => "1 spp",
         };
-        let mut name = format!("octree {}, {kind}", if self.octree { "on" } else { "off" });
+        let accel = match self.accel {
+            Accel::Octree => "octree on",
+            Accel::Bvh => "BVH",
+            Accel::BruteForce => "octree off",
+        };
+        let mut name = format!("{accel}, {kind}");
         if self.view != ViewMode::Shaded {
             name += &format!(", {} view", self.view.name());
         }
@@ -425,18 +441,22 @@ mod tests {
 
     #[test]
     fn series_say_what_their_passes_are() {
-        let key = |octree, kind, view| SeriesKey { octree, kind, view };
+        let key = |accel, kind, view| SeriesKey { accel, kind, view };
         assert_eq!(
-            key(true, Engine::OneSample, ViewMode::Shaded).name(),
+            key(Accel::Octree, Engine::OneSample, ViewMode::Shaded).name(),
             "octree on, 1 spp"
         );
         assert_eq!(
-            key(false, Engine::Grid, ViewMode::Cost).name(),
+            key(Accel::BruteForce, Engine::Grid, ViewMode::Cost).name(),
             "octree off, 16 spp, cost view"
         );
         assert_eq!(
-            key(true, Engine::Corners, ViewMode::Shaded).name(),
+            key(Accel::Octree, Engine::Corners, ViewMode::Shaded).name(),
             "octree on, SPD corners"
+        );
+        assert_eq!(
+            key(Accel::Bvh, Engine::Grid, ViewMode::Shaded).name(),
+            "BVH, 16 spp"
         );
     }
 }

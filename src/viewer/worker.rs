@@ -92,7 +92,7 @@ struct Shared {
     full_generation: AtomicU64,
     /// The octree switch of the last full job rendered: a job that flips
     /// it always renders, its time being what the user toggled to see.
-    last_octree_switch: Mutex<Option<bool>>,
+    last_octree_switch: Mutex<Option<crate::settings::Accel>>,
 }
 
 /// While the user drags: the generation of the preview in flight (sent or
@@ -427,7 +427,10 @@ fn render_job(shared: &Shared, generation: u64, job: &Job) {
         settings.shadows = p.shadows;
     }
     let renderer = match Renderer::with_camera(&job.scene, &job.octree, settings, &job.camera) {
-        Ok(r) => r,
+        Ok(r) => match &job.bvh {
+            Some(bvh) => r.with_bvh(bvh),
+            None => r,
+        },
         Err(e) => {
             shared.fail(format!("cannot render: {e}"));
             return;
@@ -439,8 +442,8 @@ fn render_job(shared: &Shared, generation: u64, job: &Job) {
                 .last_octree_switch
                 .lock()
                 .unwrap_or_else(|e| e.into_inner());
-            let switched = last.is_some_and(|on| on != job.settings.use_octree);
-            *last = Some(job.settings.use_octree);
+            let switched = last.is_some_and(|accel| accel != job.settings.accel());
+            *last = Some(job.settings.accel());
             switched
         };
         if !switched && show_cached(shared, generation, job, &renderer.plan(true)) {
@@ -512,7 +515,7 @@ fn show_cached(
             history.push(PassRecord {
                 generation,
                 anti_aliasing: job.settings.samples > 1,
-                octree: job.settings.use_octree,
+                accel: job.settings.accel(),
                 view: job.settings.view,
                 from_cache: true,
                 ..r

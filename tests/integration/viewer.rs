@@ -13,7 +13,7 @@ use egui_kittest::kittest::Queryable;
 use glint::image::frame::rgba_to_rgb;
 use glint::render::PassKind as Engine;
 use glint::render::Renderer;
-use glint::settings::AntiAliasing;
+use glint::settings::{Accel, AntiAliasing};
 use glint::viewer::GlintApp;
 use glint::viewer::worker::{ShownPass, Worker};
 
@@ -22,11 +22,11 @@ fn toggling_octree_and_anti_aliasing_restarts_the_passes() {
     let mut h = harness(small_app());
     let before = h.state().worker().generation();
     assert!(h.state().settings().use_octree);
-    h.get_by_label("Octree").click();
+    h.get_by_label("None").click();
     h.run_steps(2);
     assert!(
         !h.state().settings().use_octree,
-        "the checkbox turns the octree off"
+        "\"None\" turns the octree off"
     );
     let after_octree = h.state().worker().generation();
     assert!(after_octree > before, "a new render was started");
@@ -104,7 +104,7 @@ fn pin_as_a_then_octree_off_reads_zero_pixels_differ() {
     h.get_by_label("Pin as A").click();
     h.run_steps(2);
     assert!(h.state().compare().is_some(), "A is pinned");
-    h.get_by_label("Octree").click();
+    h.get_by_label("None").click();
     h.run_steps(2);
     assert!(!h.state().settings().use_octree);
     settle(&mut h);
@@ -115,7 +115,7 @@ fn pin_as_a_then_octree_off_reads_zero_pixels_differ() {
             .worker()
             .history()
             .iter()
-            .any(|r| r.generation == generation && !r.octree),
+            .any(|r| r.generation == generation && r.accel == Accel::BruteForce),
         "B is a finished pass with the octree off"
     );
     assert_eq!(stats.differing, 0, "octree on vs off: {stats:?}");
@@ -142,11 +142,12 @@ fn pin_as_a_then_octree_off_reads_zero_pixels_differ() {
     );
 }
 
-/// The octree switch always renders, and while the new pass runs the
-/// timing panel shows no figure of the image before: its rows read
-/// "rendering…", nothing is "kept", the status is not "done".
+/// A change of accelerator always renders, and while the new pass runs
+/// the timing panel shows no figure of the image before: its rows read
+/// "rendering…", nothing is "kept", the status is not "done". Once in, the
+/// panel shows the chosen accelerator's figures.
 #[test]
-fn an_octree_toggle_renders_and_the_panel_waits_for_the_new_figures() {
+fn an_accelerator_change_renders_and_the_panel_waits_for_the_new_figures() {
     // 96x72: a brute-force pass takes about 2 s here, long enough to be
     // caught mid-pass two frames after the switch.
     let mut app = app_for("scenes/default.toml", 96, 72);
@@ -155,25 +156,35 @@ fn an_octree_toggle_renders_and_the_panel_waits_for_the_new_figures() {
     settle(&mut h);
     let labels =
         |h: &Harness<'static, GlintApp>, text: &str| h.query_all_by_label_contains(text).count();
-    for on in [false, true, false] {
-        h.get_by_label("Octree").click();
+    for (label, accel, figure) in [
+        ("None", Accel::BruteForce, "off: every ray tests all"),
+        ("Octree", Accel::Octree, "octree build"),
+        ("BVH", Accel::Bvh, "BVH build"),
+    ] {
+        h.get_by_label(label).click();
         h.run_steps(2);
-        assert_eq!(h.state().settings().use_octree, on);
+        assert_eq!(h.state().settings().accel(), accel);
+        let on = accel.name();
         let generation = h.state().worker().generation();
         if !h.state().final_pass_shown() {
             // Mid-pass (the brute-force passes take seconds here).
-            assert!(labels(&h, "rendering…") >= 1, "octree {on}: the rows wait");
-            assert_eq!(labels(&h, "kept"), 0, "octree {on}: no kept figure");
-            assert_eq!(labels(&h, "done:"), 0, "octree {on}: not done");
+            assert!(labels(&h, "rendering…") >= 1, "{on}: the rows wait");
+            assert_eq!(labels(&h, "kept"), 0, "{on}: no kept figure");
+            assert_eq!(labels(&h, "done:"), 0, "{on}: not done");
         }
         settle(&mut h);
         assert!(
             h.state().worker().tiles_started(generation) > 0,
-            "octree {on}: the switch rendered"
+            "{on}: the switch rendered"
         );
         h.run_steps(2);
-        assert_eq!(labels(&h, "kept"), 0, "octree {on}: rendered, not kept");
-        assert_eq!(labels(&h, "rendering…"), 0, "octree {on}: figures in");
+        assert_eq!(labels(&h, "kept"), 0, "{on}: rendered, not kept");
+        assert_eq!(labels(&h, "rendering…"), 0, "{on}: figures in");
+        assert_eq!(
+            labels(&h, figure),
+            1,
+            "{on}: the timing panel shows its figures"
+        );
     }
 }
 

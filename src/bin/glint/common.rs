@@ -54,10 +54,14 @@ impl AccelArg {
     }
 
     pub fn name(self) -> &'static str {
+        self.accel().name()
+    }
+
+    pub fn accel(self) -> glint::settings::Accel {
         match self {
-            AccelArg::Octree => "octree",
-            AccelArg::Bvh => "bvh",
-            AccelArg::None => "none",
+            AccelArg::Octree => glint::settings::Accel::Octree,
+            AccelArg::Bvh => glint::settings::Accel::Bvh,
+            AccelArg::None => glint::settings::Accel::BruteForce,
         }
     }
 }

@@ -118,7 +118,11 @@ fn write_info(
     writeln!(
         out,
         "octree        {} (max depth {}, leaf size {}, cost-driven {}, max duplication {}, budget {} MiB)",
-        if r.use_octree { "on" } else { "off" },
+        match r.accel() {
+            glint::settings::Accel::Octree => "on",
+            glint::settings::Accel::Bvh => "off, a BVH instead",
+            glint::settings::Accel::BruteForce => "off",
+        },
         s.octree_params.max_depth,
         s.octree_params.leaf_size,
         s.octree_params.cost_driven,

@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use glint::accel::{Bvh, Octree};
 use glint::camera::CameraSpec;
 use glint::render::{FinishedTile, PassInfo, PassOptions, PassWatch, RenderedFrame, Renderer};
-use glint::settings::{Overrides, RenderSettings, ViewMode};
+use glint::settings::{Accel, Overrides, RenderSettings, ViewMode};
 
 use crate::common::{
     AccelArg, OctreeArgs, RulesArgs, Switch, load_scene, parse_pixel, parse_positive,
@@ -188,7 +188,6 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
             .unwrap_or(glint::limits::DEFAULT_OVERLAY_DEPTH)
     });
     let mut legend = true;
-    let mut recorded_bvh = false;
     let (mut scene, scene_name, mut settings, camera) = match (&args.from_png, &args.scene) {
         (Some(png), _) => {
             let restored = glint::export::restore(png)
@@ -201,7 +200,6 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
                 .map(|d| args.overlay_depth.unwrap_or(d))
                 .or(overlay_depth);
             legend = restored.legend;
-            recorded_bvh = restored.bvh;
             (
                 restored.scene,
                 restored.scene_path,
@@ -221,12 +219,8 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
     if let Some(switch) = args.legend {
         legend = switch.is_on();
     }
-    let accel =
-        AccelArg::resolve(args.accel, args.octree)?.or(recorded_bvh.then_some(AccelArg::Bvh));
     let mut overrides = overrides(args);
-    if let Some(a) = accel {
-        overrides.use_octree = Some(a == AccelArg::Octree);
-    }
+    overrides.accel = AccelArg::resolve(args.accel, args.octree)?.map(AccelArg::accel);
     overrides.apply(&mut settings, &mut scene.octree_params);
 
     let pool = thread_pool(args.threads)?;
@@ -244,7 +238,7 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
     } else {
         Octree::build(&[], scene.octree_params)?
     };
-    let bvh = (accel == Some(AccelArg::Bvh)).then(|| pool.install(|| Bvh::build(&scene.shapes)));
+    let bvh = (settings.accel() == Accel::Bvh).then(|| pool.install(|| Bvh::build(&scene.shapes)));
     let build_s = build_start.elapsed().as_secs_f64();
     if args.output.is_some() {
         // Validate before starting.
@@ -344,7 +338,6 @@ fn save(
     let s = &job.settings;
     let mut record = glint::export::render_record(&job.scene, &job.scene_name, &job.camera, *s);
     record.settings.legend = job.legend;
-    record.settings.bvh = job.bvh.is_some();
     let camera = glint::camera::Camera::new(&job.camera, s.width, s.height)?;
     let overlay = job
         .overlay_depth

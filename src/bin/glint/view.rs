@@ -27,6 +27,10 @@ pub struct ViewArgs {
     /// Start with the octree on or off (default: the scene's setting).
     #[arg(long, value_enum)]
     pub octree: Option<Switch>,
+    /// Start with this accelerator: octree, bvh or none (see `glint
+    /// render --accel`; it must agree with --octree when both are given).
+    #[arg(long, value_enum)]
+    pub accel: Option<crate::common::AccelArg>,
     /// Start with anti-aliasing off, adaptive or full (`on` is full;
     /// default: the scene's).
     #[arg(long, value_parser = crate::common::parse_aa)]
@@ -89,6 +93,7 @@ impl Default for ViewArgs {
             frames: 3,
             view: None,
             octree: None,
+            accel: None,
             aa: None,
             threads: 0,
             size: None,
@@ -134,6 +139,8 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         height: args.size.map(|(_, h)| h),
         anti_aliasing: args.aa,
         use_octree: args.octree.map(Switch::is_on),
+        accel: crate::common::AccelArg::resolve(args.accel, args.octree)?
+            .map(crate::common::AccelArg::accel),
         view: args.view,
         ..Overrides::default()
     };

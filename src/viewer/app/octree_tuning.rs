@@ -5,13 +5,45 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use super::GlintApp;
-use crate::accel::{Octree, OctreeParams};
+use crate::accel::{Bvh, Octree, OctreeParams};
 use crate::render::{Renderer, UnitCosts};
 use crate::scene::Scene;
-use crate::settings::RenderSettings;
+use crate::settings::{Accel, RenderSettings};
+use crate::shapes::Shape;
 use crate::viewer::octree_panel::{RaySampleJob, SuggestionJob, SuggestionView, last_full_pass};
 
+/// A BVH and what it was built over.
+pub(super) struct BuiltBvh {
+    shapes: Arc<Vec<Shape>>,
+    pub tree: Arc<Bvh>,
+    pub seconds: f64,
+}
+
 impl GlintApp {
+    /// The BVH over the edited scene's shapes when the settings ask for
+    /// one, built here the first time, as the octree is (it builds far
+    /// faster: 0.02 s for gears' 36,610 shapes, where the octree takes 0.9 s).
+    pub(super) fn bvh_if_chosen(&mut self) -> Option<Arc<Bvh>> {
+        if self.edit.settings.accel() != Accel::Bvh {
+            return None;
+        }
+        let shapes = &self.edit.scene.shapes;
+        if !self
+            .bvh
+            .as_ref()
+            .is_some_and(|b| Arc::ptr_eq(&b.shapes, shapes))
+        {
+            let start = Instant::now();
+            let tree = Bvh::build(shapes);
+            self.bvh = Some(BuiltBvh {
+                shapes: Arc::clone(shapes),
+                tree: Arc::new(tree),
+                seconds: start.elapsed().as_secs_f64(),
+            });
+        }
+        self.bvh.as_ref().map(|b| Arc::clone(&b.tree))
+    }
+
     /// Edits the octree parameters (an edit like any other: undone,
     /// saved, marked unsaved) and rebuilds the tree; the passes render
     /// again with it, so the times shown are the new tree's.

@@ -167,7 +167,7 @@ impl PassWatch for Display<'_> {
                 },
                 seconds: summary.seconds,
                 rays: summary.counts.rays,
-                octree: self.settings.use_octree,
+                accel: self.settings.accel(),
                 anti_aliasing: self.job.settings.samples > 1,
                 width: pass.frame.width,
                 height: pass.frame.height,

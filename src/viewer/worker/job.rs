@@ -4,7 +4,7 @@ use std::sync::Arc;
 
 use super::Preview;
 use super::pass_cache::PassKey;
-use crate::accel::Octree;
+use crate::accel::{Bvh, Octree};
 use crate::camera::CameraSpec;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
@@ -15,6 +15,8 @@ use crate::settings::RenderSettings;
 pub struct Job {
     pub scene: Arc<Scene>,
     pub octree: Arc<Octree>,
+    /// The BVH over the scene's shapes when the settings ask for one.
+    pub bvh: Option<Arc<Bvh>>,
     pub camera: CameraSpec,
     pub settings: RenderSettings,
     /// Render only a quick 1-sample pass (while the user drags), at

@@ -57,7 +57,8 @@ pub struct PassRecord {
     pub kind: ShownPass,
     pub seconds: f64,
     pub rays: RayCounts,
-    pub octree: bool,
+    /// What the pass's ray queries went through.
+    pub accel: crate::settings::Accel,
     pub anti_aliasing: bool,
     pub width: u32,
     pub height: u32,

@@ -48,7 +48,7 @@ fn the_history_keeps_full_passes_and_the_newest_previews() {
         },
         seconds: 0.01,
         rays: RayCounts::default(),
-        octree: true,
+        accel: crate::settings::Accel::Octree,
         anti_aliasing: false,
         width: 8,
         height: 6,

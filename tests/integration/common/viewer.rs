@@ -61,6 +61,7 @@ pub fn job(
     let job = Job {
         scene: Arc::clone(&scene),
         octree: Arc::clone(&octree),
+        bvh: None,
         camera: scene.camera,
         settings,
         preview: None,
