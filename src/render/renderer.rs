@@ -110,6 +110,41 @@ impl pulp::WithSimd for OcclusionQuery<'_> {
     }
 }
 
+/// A single ray's closest hit or shadow crossings through the BVH (nothing
+/// counted), as a function compiled for the render's SIMD level.
+struct BvhQuery<'q> {
+    bvh: &'q Bvh,
+    prims: &'q Primitives<'q>,
+    ray: &'q PreparedRay,
+    stack: &'q mut BvhStack,
+    /// `Some((distance, crossings))`: a shadow ray; `None`: a closest hit.
+    shadow: Option<(f64, &'q mut ShadowCrossings)>,
+    simd: pulp::x86::V3,
+}
+
+impl pulp::WithSimd for BvhQuery<'_> {
+    type Output = Option<ClosestHit>;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) -> Option<ClosestHit> {
+        let Self {
+            bvh,
+            prims,
+            ray,
+            stack,
+            shadow,
+            simd,
+        } = self;
+        match shadow {
+            None => bvh.closest_inline(prims, ray, f64::INFINITY, stack, &mut NoCounts, simd),
+            Some((distance, crossings)) => {
+                bvh.occlusion_inline(prims, ray, distance, crossings, stack, &mut NoCounts, simd);
+                None
+            }
+        }
+    }
+}
+
 /// Crossings of one material closer than this, relative to the scene's
 /// magnitude, are one surface: far above the rounding of hit distances,
 /// far below any thickness a scene models.
@@ -279,13 +314,21 @@ impl<'a> Renderer<'a> {
     ) -> Option<ClosestHit> {
         let prims = self.primitives();
         if let Some(bvh) = self.bvh() {
-            return bvh.closest(
-                &prims,
-                ray,
-                f64::INFINITY,
-                &mut query.scratch.bvh,
-                query.counter,
-            );
+            let stack = &mut query.scratch.bvh;
+            if !C::COUNTS
+                && let Some(simd) = self.single_rays.avx2()
+            {
+                let query = BvhQuery {
+                    bvh,
+                    prims: &prims,
+                    ray,
+                    stack,
+                    shadow: None,
+                    simd,
+                };
+                return pulp::Simd::vectorize(simd, query);
+            }
+            return bvh.closest(&prims, ray, f64::INFINITY, stack, query.counter);
         }
         if self.settings.use_octree {
             let stack = &mut query.scratch.stack;
@@ -330,7 +373,20 @@ impl<'a> Renderer<'a> {
             crossings,
         } = &mut *query.scratch;
         if let Some(tree) = self.bvh() {
-            tree.occlusion(&prims, ray, distance, crossings, bvh, query.counter);
+            match self.single_rays.avx2() {
+                Some(simd) if !C::COUNTS => {
+                    let query = BvhQuery {
+                        bvh: tree,
+                        prims: &prims,
+                        ray,
+                        stack: bvh,
+                        shadow: Some((distance, crossings)),
+                        simd,
+                    };
+                    pulp::Simd::vectorize(simd, query);
+                }
+                _ => tree.occlusion(&prims, ray, distance, crossings, bvh, query.counter),
+            }
         } else if self.settings.use_octree {
             match self.single_rays.avx2() {
                 Some(simd) if !C::COUNTS => pulp::Simd::vectorize(

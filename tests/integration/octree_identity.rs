@@ -202,6 +202,7 @@ fn agree(
         &mut WorkCounts::default(),
     );
     prop_assert_eq!(&b, &t, "shadow verdict (counted) differs for {:?}", ray);
+    // The BVH: its wide walk (nothing counted) and its binary one.
     let mut bvh_stack = BvhStack::default();
     let found = bvh.closest(
         prims,
@@ -211,6 +212,28 @@ fn agree(
         &mut NoCounts,
     );
     prop_assert_eq!(brute, found, "the BVH's closest hit differs for {:?}", ray);
+    let counted = bvh.closest(
+        prims,
+        &prepared,
+        f64::INFINITY,
+        &mut bvh_stack,
+        &mut WorkCounts::default(),
+    );
+    prop_assert_eq!(
+        brute,
+        counted,
+        "the BVH's closest hit (counted) differs for {:?}",
+        ray
+    );
+    bvh.occlusion(
+        prims,
+        &prepared,
+        shadow_length,
+        &mut t,
+        &mut bvh_stack,
+        &mut NoCounts,
+    );
+    prop_assert_eq!(&b, &t, "the BVH's shadow verdict differs for {:?}", ray);
     bvh.occlusion(
         prims,
         &prepared,
@@ -219,6 +242,11 @@ fn agree(
         &mut bvh_stack,
         &mut WorkCounts::default(),
     );
-    prop_assert_eq!(&b, &t, "the BVH's shadow verdict differs for {:?}", ray);
+    prop_assert_eq!(
+        &b,
+        &t,
+        "the BVH's shadow verdict (counted) differs for {:?}",
+        ray
+    );
     Ok(())
 }

@@ -1,6 +1,8 @@
 //! Binned surface-area-heuristic build (Wald 2007).
 
-use super::tree::{Bvh, BvhNode, BvhStats};
+use super::node::BvhNode;
+use super::tree::{Bvh, BvhStats};
+use super::wide::WideNodes;
 use crate::math::{Aabb, DVec3};
 use crate::shapes::Shape;
 
@@ -78,12 +80,14 @@ impl Bvh {
             bvh.refs = items.iter().map(|it| it.shape).collect();
             bvh.nodes.reserve(2 * items.len());
             flatten(&root, 0, &mut bvh.nodes, &mut bvh.stats);
+            bvh.wide = WideNodes::build(&bvh.nodes);
         }
         bvh.stats.nodes = bvh.nodes.len() as u64;
         bvh.stats.references = bvh.refs.len() as u64;
         bvh.stats.memory_bytes = (bvh.nodes.len() * std::mem::size_of::<BvhNode>()
             + (bvh.refs.len() + bvh.unbounded.len()) * std::mem::size_of::<u32>())
-            as u64;
+            as u64
+            + bvh.wide.memory_bytes();
         bvh
     }
 }

@@ -16,8 +16,10 @@
 //! (distance, shape index) and a shadow ray collects the same crossings.
 
 mod build;
+mod node;
 mod tree;
 mod walk;
+mod wide;
 
 pub use tree::{Bvh, BvhStats};
 pub use walk::BvhStack;

@@ -103,6 +103,7 @@ fn rays_along_axes_and_through_shared_boundaries_agree_with_brute_force() {
     // and uncounted.
     let shapes = sphere_grid(4, 0.6);
     let bvh = Bvh::build(&shapes);
+    assert!(bvh.has_wide(), "uncounted queries take the wide walk");
     let prims = Primitives::opaque(&shapes);
     let mut rays = Vec::new();
     for a in [0.0, 1.0, 1.5, 2.0, 0.2, 3.6] {
@@ -129,9 +130,12 @@ fn rays_along_axes_and_through_shared_boundaries_agree_with_brute_force() {
         assert_eq!(counted, brute, "{:?}", ray.ray);
         assert!(counts.intersection_tests <= shapes.len() as u64);
         hits += found.is_some() as usize;
-        bvh.occlusion(&prims, &ray, 20.0, &mut a, &mut stack, &mut NoCounts);
         occlusion_brute_force(&prims, &ray, 20.0, &mut b, &mut NoCounts);
+        bvh.occlusion(&prims, &ray, 20.0, &mut a, &mut stack, &mut NoCounts);
         assert_eq!(a, b, "{:?}", ray.ray);
+        let mut counts = WorkCounts::default();
+        bvh.occlusion(&prims, &ray, 20.0, &mut a, &mut stack, &mut counts);
+        assert_eq!(a, b, "{:?} (counted)", ray.ray);
     }
     assert!(hits > 40, "the rays meet the grid ({hits} hits)");
 }

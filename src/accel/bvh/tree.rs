@@ -1,18 +1,8 @@
 //! The built hierarchy: its flattened nodes and references, and what it
 //! says of itself. Building is `build.rs`'s, the traversal `walk.rs`'s.
 
-use crate::math::Aabb;
-
-/// A node of the flattened tree, in depth-first order: an interior node's
-/// first child follows it, its second is at `first_or_second`.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct BvhNode {
-    pub(super) bounds: Aabb,
-    /// Leaf: index of its first reference. Interior: index of the second child.
-    pub(super) first_or_second: u32,
-    /// References of a leaf; 0 for an interior node.
-    pub(super) count: u32,
-}
+use super::node::BvhNode;
+use super::wide::WideNodes;
 
 /// The built hierarchy.
 #[derive(Clone, Debug, Default)]
@@ -22,6 +12,8 @@ pub struct Bvh {
     /// Shapes without bounds (planes, unclipped quadrics), tested for every ray.
     pub(super) unbounded: Vec<u32>,
     pub(super) stats: BvhStats,
+    /// The same tree in eight-wide nodes, for uncounted queries.
+    pub(super) wide: WideNodes,
 }
 
 /// What the build made, for the statistics a user compares with the
@@ -41,5 +33,10 @@ pub struct BvhStats {
 impl Bvh {
     pub fn stats(&self) -> BvhStats {
         self.stats
+    }
+
+    /// Whether the uncounted queries can take the wide walk.
+    pub(super) fn has_wide(&self) -> bool {
+        !self.wide.is_empty()
     }
 }

@@ -1,12 +1,14 @@
 //! The traversal: depth first, nearer child first, for the closest hit and
 //! for shadow rays.
 
-use super::tree::{Bvh, BvhNode};
+use super::node::BvhNode;
+use super::tree::Bvh;
+use crate::accel::octree::bounds::{Baseline, BoxLanes};
 use crate::accel::primitives::{
     ClosestHit, Primitives, ShadowCrossings, test_closest, test_occlusion,
 };
 use crate::shapes::PreparedRay;
-use crate::stats::Counter;
+use crate::stats::{Counter, NoCounts};
 
 /// A node is skipped only when the ray enters it this far (relative)
 /// beyond the best hit or the end of the ray: far above the rounding of
@@ -15,9 +17,12 @@ use crate::stats::Counter;
 const SLACK: f64 = 1e-9;
 
 /// The nodes still to visit, with the distance at which the ray enters
-/// each. One per tile, so no ray allocates.
+/// each (binary walk, and wide walk). One per tile, so no ray allocates.
 #[derive(Default)]
-pub struct BvhStack(Vec<(u32, f64)>);
+pub struct BvhStack {
+    binary: Vec<(u32, f64)>,
+    wide: Vec<(u32, f32)>,
+}
 
 /// `t` grown by [`SLACK`].
 #[inline(always)]
@@ -63,6 +68,21 @@ impl Bvh {
         stack: &mut BvhStack,
         counter: &mut C,
     ) -> Option<ClosestHit> {
+        self.closest_inline(prims, ray, t_max, stack, counter, Baseline)
+    }
+
+    /// [`Bvh::closest`], inlined into a caller compiled for a SIMD level
+    /// whose `lanes` test a wide node's children.
+    #[inline(always)]
+    pub fn closest_inline<C: Counter, L: BoxLanes>(
+        &self,
+        prims: &Primitives,
+        ray: &PreparedRay,
+        t_max: f64,
+        stack: &mut BvhStack,
+        counter: &mut C,
+        lanes: L,
+    ) -> Option<ClosestHit> {
         let mut best = None;
         for &i in &self.unbounded {
             test_closest(prims, i, ray, &mut best, t_max, counter);
@@ -71,7 +91,27 @@ impl Bvh {
         let Some(root) = self.nodes.first() else {
             return best;
         };
-        let stack = &mut stack.0;
+        if !C::COUNTS && self.has_wide() {
+            let best = std::cell::Cell::new(best);
+            self.wide.walk(
+                ray.ray.origin.to_array(),
+                ray.inv_dir,
+                &mut stack.wide,
+                lanes,
+                || limit(&best.get()),
+                |first, count| {
+                    let mut found = best.get();
+                    let refs = &self.refs[first as usize..(first + count) as usize];
+                    for &shape in refs {
+                        test_closest(prims, shape, ray, &mut found, t_max, &mut NoCounts);
+                    }
+                    best.set(found);
+                    false
+                },
+            );
+            return best.get();
+        }
+        let stack = &mut stack.binary;
         stack.clear();
         if let Some(t) = root.entry(ray, limit(&best)) {
             stack.push((0, t));
@@ -122,6 +162,23 @@ impl Bvh {
         stack: &mut BvhStack,
         counter: &mut C,
     ) {
+        self.occlusion_inline(prims, ray, t_max, found, stack, counter, Baseline);
+    }
+
+    /// [`Bvh::occlusion`], inlined into a caller compiled for a SIMD level
+    /// whose `lanes` test a wide node's children.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub fn occlusion_inline<C: Counter, L: BoxLanes>(
+        &self,
+        prims: &Primitives,
+        ray: &PreparedRay,
+        t_max: f64,
+        found: &mut ShadowCrossings,
+        stack: &mut BvhStack,
+        counter: &mut C,
+        lanes: L,
+    ) {
         found.clear();
         for &i in &self.unbounded {
             if test_occlusion(prims, i, ray, t_max, found, counter) {
@@ -132,7 +189,23 @@ impl Bvh {
             return;
         };
         let limit = widen(t_max);
-        let stack = &mut stack.0;
+        if !C::COUNTS && self.has_wide() {
+            self.wide.walk(
+                ray.ray.origin.to_array(),
+                ray.inv_dir,
+                &mut stack.wide,
+                lanes,
+                || limit,
+                |first, count| {
+                    let refs = &self.refs[first as usize..(first + count) as usize];
+                    refs.iter().any(|&shape| {
+                        test_occlusion(prims, shape, ray, t_max, found, &mut NoCounts)
+                    })
+                },
+            );
+            return;
+        }
+        let stack = &mut stack.binary;
         stack.clear();
         if root.entry(ray, limit).is_some() {
             stack.push((0, 0.0));

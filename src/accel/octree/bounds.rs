@@ -22,7 +22,7 @@ pub(super) const WIDTH: usize = 8;
 /// far above the rounding of `f64` hit points (so a computed hit never
 /// lies outside the box of the shape it is on), far below the size of
 /// anything a scene models.
-const PAD_RELATIVE: f64 = 1e-9;
+pub(crate) const PAD_RELATIVE: f64 = 1e-9;
 
 /// Relative error allowed each slab parameter: more than the three
 /// roundings (subtraction, product, reciprocal) of `f32` arithmetic can
@@ -31,7 +31,7 @@ const WIDEN: f32 = 1.0 / (1 << 20) as f32;
 
 /// Root sides outside this range keep the exact walk alone: relative
 /// coordinates must stay normal, finite `f32` numbers with room to spare.
-const SIDE_RANGE: std::ops::RangeInclusive<f64> = 1e-30..=1e30;
+pub(crate) const SIDE_RANGE: std::ops::RangeInclusive<f64> = 1e-30..=1e30;
 
 /// Axis-parallel or nearly so: such an axis's slab is not tested (which
 /// only adds visits), so no product can overflow into a NaN.
@@ -61,7 +61,20 @@ impl Block {
         if negative { (hi, lo) } else { (lo, hi) }
     }
 
-    const EMPTY: Block = Block {
+    /// Writes `held` grown by `pad`, relative to `origin` and rounded
+    /// outward, into lane `lane` (an empty box stays empty).
+    pub(crate) fn set(&mut self, lane: usize, held: Aabb, origin: crate::math::DVec3, pad: f64) {
+        if held.is_empty() {
+            return;
+        }
+        let (lo, hi) = (held.min - origin, held.max - origin);
+        for k in 0..3 {
+            self.planes[2 * k][lane] = round_down(lo[k] - pad);
+            self.planes[2 * k + 1][lane] = round_up(hi[k] + pad);
+        }
+    }
+
+    pub(crate) const EMPTY: Block = Block {
         planes: [
             [f32::MAX; WIDTH],
             [-f32::MAX; WIDTH],
@@ -71,6 +84,12 @@ impl Block {
             [-f32::MAX; WIDTH],
         ],
     };
+}
+
+impl Default for Block {
+    fn default() -> Self {
+        Block::EMPTY
+    }
 }
 
 /// The boxes of what each node holds: a [`Block`] per interior node (of
@@ -243,10 +262,20 @@ impl BoxRay {
     /// where it is parallel to an axis's planes).
     #[inline(always)]
     pub(super) fn from_parts(origin: [f64; 3], inv_dir: [f64; 3], root: &Cell) -> Self {
+        Self::relative_to(origin, inv_dir, root.min)
+    }
+
+    /// The same, for boxes relative to `corner`.
+    #[inline(always)]
+    pub(crate) fn relative_to(
+        origin: [f64; 3],
+        inv_dir: [f64; 3],
+        corner: crate::math::DVec3,
+    ) -> Self {
         let o = [
-            origin[0] - root.min.x,
-            origin[1] - root.min.y,
-            origin[2] - root.min.z,
+            origin[0] - corner.x,
+            origin[1] - corner.y,
+            origin[2] - corner.z,
         ];
         let mut negative_axes = [false; 3];
         let mut near_origin = [0.0; 3];
@@ -286,7 +315,7 @@ impl BoxRay {
 /// The limit `t` as an `f32` no smaller than it, widened as the box
 /// parameters are.
 #[inline(always)]
-pub(super) fn limit_f32(t: f64) -> f32 {
+pub(crate) fn limit_f32(t: f64) -> f32 {
     if !t.is_finite() {
         // No limit, or (a blocked shadow lane) below everything.
         return if t == f64::NEG_INFINITY {
@@ -364,15 +393,6 @@ impl Fill<'_> {
     /// Writes `held`, padded, relative and rounded outward, into lane
     /// `lane` of block `block` (an empty box stays empty).
     fn set(&mut self, block: usize, lane: usize, held: Aabb) {
-        if held.is_empty() {
-            return;
-        }
-        let lo = held.min - self.origin;
-        let hi = held.max - self.origin;
-        let planes = &mut self.boxes.blocks[block].planes;
-        for k in 0..3 {
-            planes[2 * k][lane] = round_down(lo[k] - self.pad);
-            planes[2 * k + 1][lane] = round_up(hi[k] + self.pad);
-        }
+        self.boxes.blocks[block].set(lane, held, self.origin, self.pad);
     }
 }

@@ -28,7 +28,8 @@
 //! the wide walk instead (`wide_walk.rs`): each node's children tested at
 //! once against the boxes of what they hold, with the same answers.
 
-mod bounds;
+// The eight-wide box test, shared with the BVH's wide nodes.
+pub(crate) mod bounds;
 mod build;
 mod node;
 mod packet_walk;
