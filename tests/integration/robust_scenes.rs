@@ -363,6 +363,31 @@ fn torture_scenes_build_within_budget_and_render_like_brute_force() {
             ..OctreeParams::default()
         };
         assert_bounded_and_exact(name, text, tight);
+        // The BVH on the same scenes: the same pixels, one reference per
+        // shape, and a depth the median splits keep logarithmic.
+        let scene = scene_from(text, &format!("{name}.nff"));
+        let octree = Octree::build(&scene.shapes, OctreeParams::default()).unwrap();
+        let bvh = glint::accel::Bvh::build(&scene.shapes);
+        let stats = bvh.stats();
+        assert!(stats.references <= scene.shapes.len() as u64, "{name}");
+        assert!(
+            stats.max_depth <= 64,
+            "{name}: BVH depth {}",
+            stats.max_depth
+        );
+        let (brute, _) = render_with(&scene, &octree, 40, 40, |s| s.use_octree = false);
+        let mut settings = scene.render_settings();
+        (settings.width, settings.height) = (40, 40);
+        settings.set_accel(glint::settings::Accel::Bvh);
+        let renderer = glint::render::Renderer::new(&scene, &octree, settings)
+            .unwrap()
+            .with_bvh(&bvh);
+        let through_bvh = renderer.render(false, None).0.to_rgb8();
+        assert!(
+            through_bvh == brute,
+            "{name}: the BVH and brute force differ"
+        );
+        eprintln!("{name}: BVH {stats:?}");
     }
 }
 

@@ -115,8 +115,21 @@ fn split(items: &mut [Item], offset: usize, depth: u32) -> Built {
     };
     let (lo, width) = (centroids.min[axis], extent[axis]);
     if !(width > 0.0) {
-        // Every centroid at one place: no plane separates them.
-        return leaf;
+        // Every centroid at one place (nested spheres, coincident
+        // triangles): no plane separates them, but their sizes may. The
+        // larger half and the smaller half: a ray that misses the smaller
+        // half's box, or meets the larger shapes first, skips it.
+        if items.len() <= MAX_LEAF {
+            return leaf;
+        }
+        let middle = items.len() / 2;
+        items.select_nth_unstable_by(middle, |a, b| {
+            b.bounds
+                .surface_area()
+                .total_cmp(&a.bounds.surface_area())
+                .then(a.shape.cmp(&b.shape))
+        });
+        return join(items, middle, offset, depth);
     }
     if depth >= MEDIAN_BELOW {
         let middle = items.len() / 2;
