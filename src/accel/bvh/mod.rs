@@ -11,7 +11,9 @@
 //!
 //! Traversal: depth first on a per-thread stack, the nearer child first,
 //! skipping a node whose box the ray enters beyond the best hit so far.
-//! Primitive tests are the octree's and brute force's (`primitives.rs`), so
+//! Counted queries walk the binary tree (`walk.rs`; its steps are what
+//! the statistics report); the others walk it collapsed into eight-wide
+//! nodes tested in `f32` lanes (`wide.rs`). Primitive tests are the octree's and brute force's (`primitives.rs`), so
 //! the answers are theirs: the closest hit is the lexicographic minimum of
 //! (distance, shape index) and a shadow ray collects the same crossings.
 
