@@ -11,6 +11,7 @@ use glint::accel::{
 };
 use glint::math::{DVec3, Ray};
 use glint::render::Renderer;
+use glint::settings::RenderSettings;
 use glint::shapes::{PreparedRay, Shape, Sphere, Triangle};
 use glint::stats::{NoCounts, WorkCounts};
 use proptest::prelude::*;
@@ -44,16 +45,46 @@ fn octree_on_and_off_and_the_bvh_give_identical_bytes_for_every_scene() {
         let bvh = Bvh::build(&scene.shapes);
         let mut settings = scene.render_settings();
         (settings.width, settings.height, settings.samples) = (side, side, 1);
+        settings.set_accel(glint::settings::Accel::Bvh);
         let renderer = Renderer::new(scene, octree, settings)
             .unwrap()
             .with_bvh(&bvh);
-        let (frame, c_bvh) = renderer.render(true, None);
+        // Uncounted: single rays through the BVH's wide walk; counted:
+        // through its binary walk.
+        let (frame, _) = renderer.render(false, None);
         assert!(
             frame.to_rgb8() == on,
             "{name}: the BVH's image differs from the octree's"
         );
+        let (frame, c_bvh) = renderer.render(true, None);
+        assert!(
+            frame.to_rgb8() == on,
+            "{name}: the BVH's image (counted) differs from the octree's"
+        );
+        // With 16 samples a pixel's rays go as packets: through the BVH's
+        // packet walk, and through the octree's.
+        let full = RenderSettings {
+            samples: 16,
+            ..settings
+        };
+        let through = |settings: RenderSettings| {
+            let renderer = Renderer::new(scene, octree, settings)
+                .unwrap()
+                .with_bvh(&bvh);
+            renderer.render(false, None).0.to_rgb8()
+        };
+        let mut octree_full = full;
+        octree_full.set_accel(glint::settings::Accel::Octree);
+        assert!(
+            through(full) == through(octree_full),
+            "{name}: 16 samples through the BVH's packets differ from the octree's"
+        );
         assert_eq!(c_on.rays, c_bvh.rays, "{name}: different rays were cast");
         let brute_force_tests = scene.shapes.len() as u64 * c_bvh.rays.total();
+        assert!(
+            c_bvh.work.traversal_steps > 0 && c_bvh.work.leaves_visited > 0,
+            "{name}: nothing went through the BVH"
+        );
         assert!(
             (1..=brute_force_tests).contains(&c_bvh.work.intersection_tests),
             "{name}: the BVH counted {} tests, brute force would make {brute_force_tests}",

@@ -19,10 +19,12 @@
 
 mod build;
 mod node;
+mod packet_walk;
 mod tree;
 mod walk;
 mod wide;
 
+pub use packet_walk::BvhPacketStack;
 pub use tree::{Bvh, BvhStats};
 pub use walk::BvhStack;
 
