@@ -8,7 +8,7 @@ mod primitives;
 mod walk_log;
 
 pub use crate::stats::walk_record::{CellVisit, QueryRecord, StepKind, Tested, WalkEnd, WalkStep};
-pub use bvh::{Bvh, BvhPacketStack, BvhStack, BvhStats};
+pub use bvh::{Bvh, BvhStack, BvhStats};
 pub use octree::{
     Baseline, BoxLanes, DEFAULT_MEMORY_BUDGET_MIB, Octree, OctreeCell, OctreeError, OctreeParams,
     OctreeStats, PacketStack, PredictedCost, WalkStack,

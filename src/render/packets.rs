@@ -14,7 +14,7 @@
 // Lane loops index several arrays by the same lane number.
 #![allow(clippy::needless_range_loop)]
 
-use crate::accel::{Bvh, BvhPacketStack, ClosestHit, PacketStack, Primitives};
+use crate::accel::{ClosestHit, PacketStack, Primitives};
 use crate::math::{Color, DVec3, Ray};
 use crate::render::ray_tree::{NoRecord, RayKind, RayRecorder};
 use crate::shapes::{PacketHits, PreparedRay, RayPacket, ShapeHit};
@@ -27,11 +27,9 @@ use super::renderer::{Query, Renderer, Scratch};
 use super::tile_job::{PixelSum, TileJob, TileOutput, keep_scratch, spare_scratch};
 use super::tiles::Tile;
 
-/// Scratch space for a tile's packets: the octree walk's stack and the
-/// BVH's.
+/// Scratch space for a tile's packets: the walk's stack.
 pub(super) struct PacketScratch<const N: usize> {
     walk: PacketStack<N>,
-    bvh: BvhPacketStack,
 }
 
 /// A tile's job, run by [`crate::simd::dispatch`] with the level's lanes.
@@ -91,31 +89,6 @@ impl<C: Counter, const N: usize> pulp::WithSimd for ClosestWalk<'_, '_, '_, C, N
     }
 }
 
-/// A packet's closest hits through the BVH, as a function of its own per
-/// SIMD level (see [`ClosestWalk`]).
-struct BvhWalk<'w, 'r, C, const N: usize> {
-    bvh: &'r Bvh,
-    prims: &'w Primitives<'r>,
-    packet: &'w RayPacket<N>,
-    stack: &'w mut BvhPacketStack,
-    counter: &'w mut C,
-}
-
-impl<C: Counter, const N: usize> pulp::WithSimd for BvhWalk<'_, '_, C, N> {
-    type Output = PacketHits<N>;
-
-    #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _simd: S) -> PacketHits<N> {
-        self.bvh.closest_packet(
-            self.prims,
-            self.packet,
-            splat(f64::INFINITY),
-            self.stack,
-            self.counter,
-        )
-    }
-}
-
 /// The secondary rays of a packet's hits, as a function of its own per
 /// SIMD level (see [`ClosestWalk`]): inlined into the eye rays' function,
 /// its size cost the scenes without secondary rays 3 % of their
@@ -157,7 +130,6 @@ impl<const N: usize> Default for PacketScratch<N> {
     fn default() -> Self {
         Self {
             walk: PacketStack::default(),
-            bvh: BvhPacketStack::default(),
         }
     }
 }
@@ -335,27 +307,17 @@ impl Renderer<'_> {
         query: &mut Query<C>,
         stack: &mut PacketScratch<N>,
     ) -> [Option<ClosestHit>; N] {
-        let bvh = self.bvh();
-        if (bvh.is_some() || self.packets_through_octree())
+        if self.packets_through_octree()
             && let Some(packet) = RayPacket::<N>::from_rays(rays)
         {
             let prims = self.primitives();
-            let best = match bvh {
-                Some(bvh) => simd.vectorize(BvhWalk {
-                    bvh,
-                    prims: &prims,
-                    packet: &packet,
-                    stack: &mut stack.bvh,
-                    counter: &mut *query.counter,
-                }),
-                None => simd.vectorize(ClosestWalk {
-                    renderer: self,
-                    prims: &prims,
-                    packet: &packet,
-                    stack: &mut stack.walk,
-                    counter: &mut *query.counter,
-                }),
-            };
+            let best = simd.vectorize(ClosestWalk {
+                renderer: self,
+                prims: &prims,
+                packet: &packet,
+                stack: &mut stack.walk,
+                counter: &mut *query.counter,
+            });
             return std::array::from_fn(|k| {
                 (k < rays.len() && best.shape[k] != PacketHits::<N>::NONE).then(|| ClosestHit {
                     shape: best.shape[k],

@@ -290,7 +290,7 @@ impl<'a> Renderer<'a> {
     }
 
     /// The BVH queries go through, if the settings ask for one and it was given.
-    pub(super) fn bvh(&self) -> Option<&'a Bvh> {
+    fn bvh(&self) -> Option<&'a Bvh> {
         self.bvh.filter(|_| self.settings.accel() == Accel::Bvh)
     }
 

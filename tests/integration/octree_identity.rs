@@ -61,8 +61,8 @@ fn octree_on_and_off_and_the_bvh_give_identical_bytes_for_every_scene() {
             frame.to_rgb8() == on,
             "{name}: the BVH's image (counted) differs from the octree's"
         );
-        // With 16 samples a pixel's rays go as packets: through the BVH's
-        // packet walk, and through the octree's.
+        // With 16 samples a pixel's rays go as packets through the octree,
+        // one by one through the BVH.
         let full = RenderSettings {
             samples: 16,
             ..settings
@@ -77,7 +77,7 @@ fn octree_on_and_off_and_the_bvh_give_identical_bytes_for_every_scene() {
         octree_full.set_accel(glint::settings::Accel::Octree);
         assert!(
             through(full) == through(octree_full),
-            "{name}: 16 samples through the BVH's packets differ from the octree's"
+            "{name}: 16 samples through the BVH differ from the octree's packets"
         );
         assert_eq!(c_on.rays, c_bvh.rays, "{name}: different rays were cast");
         let brute_force_tests = scene.shapes.len() as u64 * c_bvh.rays.total();

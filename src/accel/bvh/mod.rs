@@ -19,12 +19,10 @@
 
 mod build;
 mod node;
-mod packet_walk;
 mod tree;
 mod walk;
 mod wide;
 
-pub use packet_walk::BvhPacketStack;
 pub use tree::{Bvh, BvhStats};
 pub use walk::BvhStack;
 

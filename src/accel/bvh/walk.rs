@@ -14,7 +14,7 @@ use crate::stats::{Counter, NoCounts};
 /// beyond the best hit or the end of the ray: far above the rounding of
 /// the slab test and of hit distances, so a hit that ties with the best
 /// is never skipped.
-pub(super) const SLACK: f64 = 1e-9;
+const SLACK: f64 = 1e-9;
 
 /// The nodes still to visit, with the distance at which the ray enters
 /// each (binary walk, and wide walk). One per tile, so no ray allocates.
