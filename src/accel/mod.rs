@@ -18,3 +18,21 @@ pub use primitives::{
     occlusion_brute_force,
 };
 pub use walk_log::WalkLog;
+
+/// `n`^3 spheres of radius `radius` one unit apart, the first at the
+/// origin: what the accelerators' tests build over.
+#[cfg(test)]
+pub(crate) fn sphere_grid(n: u32, radius: f64) -> Vec<crate::shapes::Shape> {
+    let mut shapes = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            for k in 0..n {
+                let c = crate::math::DVec3::new(i as f64, j as f64, k as f64);
+                shapes.push(crate::shapes::Shape::Sphere(crate::shapes::Sphere::new(
+                    c, radius,
+                )));
+            }
+        }
+    }
+    shapes
+}

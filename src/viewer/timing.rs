@@ -208,27 +208,33 @@ fn timing_grid_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
                 row("rays: reflection", format!("{}", r.rays.reflection));
                 row("rays: refraction", format!("{}", r.rays.refraction));
             }
-            if let (Accel::Bvh, Some((bvh, seconds))) = (edit.settings.accel(), info.bvh) {
-                let stats = bvh.stats();
-                row("BVH build", format!("{seconds:.3} s"));
+            // The accelerator's build: (name, seconds, nodes, leaves, bytes).
+            let built = match (edit.settings.accel(), info.bvh) {
+                (Accel::Bvh, Some((bvh, seconds))) => {
+                    let s = bvh.stats();
+                    Some(("BVH", seconds, s.nodes, s.leaves, s.memory_bytes))
+                }
+                (Accel::Octree, _) => {
+                    let s = info.octree.stats();
+                    Some((
+                        "octree",
+                        info.build_seconds,
+                        s.nodes,
+                        s.leaves,
+                        s.memory_bytes,
+                    ))
+                }
+                _ => None,
+            };
+            if let Some((name, seconds, nodes, leaves, bytes)) = built {
+                row(&format!("{name} build"), format!("{seconds:.3} s"));
                 row(
-                    "BVH nodes",
-                    format!("{} ({} leaves)", stats.nodes, stats.leaves),
+                    &format!("{name} nodes"),
+                    format!("{nodes} ({leaves} leaves)"),
                 );
                 row(
-                    "BVH memory",
-                    format!("{:.1} KiB", stats.memory_bytes as f64 / 1024.0),
-                );
-            } else if edit.settings.use_octree {
-                let stats = info.octree.stats();
-                row("octree build", format!("{:.3} s", info.build_seconds));
-                row(
-                    "octree nodes",
-                    format!("{} ({} leaves)", stats.nodes, stats.leaves),
-                );
-                row(
-                    "octree memory",
-                    format!("{:.1} KiB", stats.memory_bytes as f64 / 1024.0),
+                    &format!("{name} memory"),
+                    format!("{:.1} KiB", bytes as f64 / 1024.0),
                 );
             } else {
                 row(

@@ -2,7 +2,9 @@
 
 use super::BvhStack;
 use super::tree::Bvh;
-use crate::accel::{Primitives, ShadowCrossings, closest_brute_force, occlusion_brute_force};
+use crate::accel::{
+    Primitives, ShadowCrossings, closest_brute_force, occlusion_brute_force, sphere_grid,
+};
 use crate::math::Aabb;
 use crate::math::{DVec3, Ray};
 use crate::shapes::{Plane, PreparedRay, Shape, Sphere};
@@ -37,19 +39,6 @@ fn shapes_below(bvh: &Bvh, shapes: &[Shape], index: usize, depth: u32) -> Vec<u3
     let mut below = shapes_below(bvh, shapes, first, depth + 1);
     below.extend(shapes_below(bvh, shapes, second, depth + 1));
     below
-}
-
-fn sphere_grid(n: u32, radius: f64) -> Vec<Shape> {
-    let mut shapes = Vec::new();
-    for i in 0..n {
-        for j in 0..n {
-            for k in 0..n {
-                let c = DVec3::new(i as f64, j as f64, k as f64);
-                shapes.push(Shape::Sphere(Sphere::new(c, radius)));
-            }
-        }
-    }
-    shapes
 }
 
 #[test]

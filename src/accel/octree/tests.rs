@@ -2,7 +2,7 @@
 
 use super::node::{Cell, INTERIOR, Node};
 use super::*;
-use crate::accel::Primitives;
+use crate::accel::{Primitives, sphere_grid};
 use crate::accel::{ShadowCrossings, closest_brute_force, occlusion_brute_force};
 use crate::math::DVec3;
 use crate::math::Ray;
@@ -32,21 +32,6 @@ fn leaves(tree: &Octree) -> Vec<(Cell, Vec<u32>)> {
         walk(tree, 0, tree.root_cell(), &mut out);
     }
     out
-}
-
-/// `n`^3 spheres of radius `radius` one unit apart, the first at the
-/// origin.
-fn sphere_grid(n: u32, radius: f64) -> Vec<Shape> {
-    let mut shapes = Vec::new();
-    for i in 0..n {
-        for j in 0..n {
-            for k in 0..n {
-                let c = DVec3::new(i as f64, j as f64, k as f64);
-                shapes.push(Shape::Sphere(Sphere::new(c, radius)));
-            }
-        }
-    }
-    shapes
 }
 
 #[test]
