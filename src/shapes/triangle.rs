@@ -193,9 +193,24 @@ pub fn triangle_overlaps_box(vertices: &[DVec3; 3], b: &Aabb) -> bool {
         let a = e.abs();
         // X × e = (0, -e.z, e.y), Y × e = (e.z, 0, -e.x), Z × e = (-e.y, e.x, 0).
         let axes = [
-            (on.z * e.y - on.y * e.z, off.z * e.y - off.y * e.z, half.y * a.z + half.z * a.y, a.y + a.z),
-            (on.x * e.z - on.z * e.x, off.x * e.z - off.z * e.x, half.x * a.z + half.z * a.x, a.x + a.z),
-            (on.y * e.x - on.x * e.y, off.y * e.x - off.x * e.y, half.x * a.y + half.y * a.x, a.x + a.y),
+            (
+                on.z * e.y - on.y * e.z,
+                off.z * e.y - off.y * e.z,
+                half.y * a.z + half.z * a.y,
+                a.y + a.z,
+            ),
+            (
+                on.x * e.z - on.z * e.x,
+                off.x * e.z - off.z * e.x,
+                half.x * a.z + half.z * a.x,
+                a.x + a.z,
+            ),
+            (
+                on.y * e.x - on.x * e.y,
+                off.y * e.x - off.x * e.y,
+                half.x * a.y + half.y * a.x,
+                a.x + a.y,
+            ),
         ];
         for (p, q, r, length) in axes {
             // A zero axis (an edge along a box normal) separates nothing.
@@ -322,10 +337,21 @@ mod tests {
             let b = Aabb::new(a.min(c), a.max(c) + DVec3::splat(0.25));
             let v = [corner(), corner(), corner()];
             let expected = plain_overlap(&v, &b);
-            assert_eq!(triangle_overlaps_box(&v, &b), expected, "{v:?} against {b:?}");
-            if expected { overlapping += 1 } else { separated += 1 }
+            assert_eq!(
+                triangle_overlaps_box(&v, &b),
+                expected,
+                "{v:?} against {b:?}"
+            );
+            if expected {
+                overlapping += 1
+            } else {
+                separated += 1
+            }
         }
-        assert!(overlapping > 10_000 && separated > 10_000, "{overlapping} {separated}");
+        assert!(
+            overlapping > 10_000 && separated > 10_000,
+            "{overlapping} {separated}"
+        );
     }
 
     #[test]
