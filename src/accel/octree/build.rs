@@ -42,8 +42,18 @@ const TRAVERSAL_COST: f64 = 1.0;
 /// Below this many references a node is classified on one thread.
 const PARALLEL_MIN: usize = 2048;
 /// Nodes of a level are classified in batches of about this many
-/// references, so a level's candidate children never all exist at once.
+/// references, so a level's candidate children never all exist at once...
 const BATCH_REFERENCES: usize = 1 << 20;
+/// ... and fewer under a small budget: a batch's candidate children hold
+/// up to eight references each of its own (4 bytes each), outside the
+/// budget's count until decided, so a batch of `budget / 256` references
+/// adds at most an eighth of the budget. (With 2^20 under a 16 MiB
+/// budget, shells -s 3 without the cost-driven stop peaked 59 MiB above
+/// the scene.)
+const BATCH_OF_BUDGET: u64 = 256;
+/// Batches never shrink below this, so that small budgets still classify
+/// in parallel.
+const MIN_BATCH_REFERENCES: usize = 4096;
 
 impl Octree {
     /// Builds the octree over the bounded shapes (unbounded ones are kept
@@ -268,6 +278,10 @@ fn try_with_capacity<T>(n: usize) -> Result<Vec<T>, OctreeError> {
 }
 
 impl Builder<'_> {
+    fn batch_references(&self) -> usize {
+        ((self.budget / BATCH_OF_BUDGET) as usize).clamp(MIN_BATCH_REFERENCES, BATCH_REFERENCES)
+    }
+
     /// Builds level by level from `root`.
     fn build(&mut self, root: Pending) -> Result<(), OctreeError> {
         let mut level = vec![root];
@@ -280,7 +294,7 @@ impl Builder<'_> {
                 // A batch of nodes, classified in parallel, decided in order.
                 let mut batch = Vec::new();
                 let mut references = 0;
-                while let Some(p) = rest.next_if(|_| references < BATCH_REFERENCES) {
+                while let Some(p) = rest.next_if(|_| references < self.batch_references()) {
                     references += p.items.len();
                     batch.push(p);
                 }
