@@ -621,9 +621,6 @@ impl GlintApp {
         } else {
             None
         };
-        if preview.is_some() {
-            self.last_preview = preview;
-        }
         let edit = &self.edit;
         let inputs = RenderInputs {
             camera: edit.camera,
@@ -634,6 +631,23 @@ impl GlintApp {
         };
         if self.submitted.as_ref() == Some(&inputs) {
             return;
+        }
+        // Held still mid-drag, the view on screen is not rendered again at
+        // another preview level because the timings moved: under load the
+        // choice could alternate on every preview, for as long as the
+        // button is down.
+        if let Some(submitted) = &self.submitted
+            && submitted.preview.is_some()
+            && inputs.preview.is_some()
+            && (RenderInputs {
+                preview: submitted.preview,
+                ..inputs.clone()
+            }) == *submitted
+        {
+            return;
+        }
+        if preview.is_some() {
+            self.last_preview = preview;
         }
         let bvh = self.bvh_if_chosen();
         let edit = &self.edit;
