@@ -2,7 +2,9 @@
 """Whether the octree a scene gets by default ever loses: for each scene,
 build + render with the default octree against brute force (octree off)
 and against the fastest setting of a sweep (maximum depths 6, 8, 10,
-leaf sizes 2 and 8, the cost-driven stop on and off), and the peak resident memory
+leaf sizes 2 and 8, the cost-driven stop on and off; its three fastest
+settings timed again, median of 3 like the default; one that builds the
+default's tree counts as the default), and the peak resident memory
 of a render with the octree against one without (what the tree adds)
 beside the memory budget. One sample per pixel, so the build weighs as
 much as it ever does. Prints a markdown table.
@@ -53,7 +55,28 @@ for scene in scenes:
     sweep = glint_json("bench", *common, "--repeat", "1", "--sweep", "--sweep-depths", "6,8,10",
                        "--sweep-leaf-sizes", "2,8", "--sweep-cost-driven", "on,off",
                        "--format", "json")
-    fastest = min([r["build_s"] + r["render_s"] for r in sweep] + [default_s])
+    # The sweep times each setting once, so its minimum is biased low by
+    # the noise of a dozen single runs: its three fastest settings are
+    # timed again like the default (median of 3) before they are compared.
+    def total(r):
+        return r["build_s"] + r["render_s"]
+
+    # A setting that builds the default's tree (same nodes, leaves and
+    # references: a scene of a few shapes is one leaf at any setting) is
+    # the default, whatever its timing noise says.
+    def tree(stats):
+        return (stats["nodes"], stats["leaves"], stats["references"], stats["max_depth"])
+
+    fastest = default_s
+    for r in sorted(sweep, key=total)[:3]:
+        if tree(r["octree_stats"]) == tree(b["octree_stats"]):
+            continue
+        p = r["octree_params"]
+        [again] = glint_json("bench", *common, "--repeat", "3", "--octree-only", "--format", "json",
+                             "--octree-max-depth", str(p["max_depth"]),
+                             "--octree-leaf-size", str(p["leaf_size"]),
+                             "--octree-cost-driven", "on" if p["cost_driven"] else "off")
+        fastest = min(fastest, again["build_s"] + again["octree_on"]["render_s"])
     # The tree is the same at any image size: a small render keeps brute
     # force quick on the big meshes.
     out = os.path.join("/tmp", "default_octree.png")
