@@ -46,7 +46,8 @@ impl Default for OctreeParams {
         // (benches/octree_sweep_256.md): leaf size 4 renders within 3% of
         // the fastest configuration (run-to-run noise) with half its
         // intersection tests, at most 0.33x Havran's best octree on every
-        // scene; depth 12 and leaf size 2 were slower. The cost-driven stop
+        // scene; depth 12 and leaf size 2 were slower. Meshes get leaf
+        // size 8 instead (`default_for`). The cost-driven stop
         // is on: without it the SPD generator's `shells` (1,441 nested,
         // overlapping spheres) split until the memory budget and took 2.3 s
         // at 200x150 against 0.62 s without an octree (0.07 s with the
