@@ -115,9 +115,8 @@ def test_views_read_what_the_keys_hold():
     assert len(scene.lights) == 3 and scene.lights[-1].position == scene.get("lights[2].position")
     assert sorted(scene.materials) == ["clay", "floor", "glass", "gold", "mirror", "teal", "violet"]
     assert scene.materials["glass"].as_dict()["ior"] == scene.get("materials.glass.ior")
-    # The default scene is mostly the bunny's triangles: a mesh's leaves.
     assert scene.octree_params.as_dict() == {
-        "enabled": True, "max_depth": 10, "leaf_size": 8, "cost_driven": True,
+        "enabled": True, "max_depth": 10, "leaf_size": 4, "cost_driven": True,
         "max_duplication": 8, "memory_budget_mib": 128}
     assert "materials.glass.ior" in scene.keys()
     copy = scene.copy()

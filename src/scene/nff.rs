@@ -11,7 +11,6 @@ use std::ops::Range;
 use tokens::Tokens;
 
 use super::model::{ImageSettings, Scene, SceneError};
-use crate::accel::OctreeParams;
 use crate::camera::CameraSpec;
 use crate::color::ColorConvention;
 use crate::limits::{
@@ -377,7 +376,6 @@ fn parse_into(
     }
     image.ambient = DVec3::splat(intensity);
     scene.image = image;
-    scene.octree_params = OctreeParams::default_for(&scene.shapes);
     Ok(scene)
 }
 
@@ -456,11 +454,6 @@ pp 3
         assert_eq!(s.materials.len(), 1);
         assert_eq!(s.materials[0].reflectivity, 0.3);
         assert_eq!(s.vertex_normals.len(), 1);
-        // A sphere and a cone beside three triangles: not a mesh's leaves.
-        assert_eq!(s.octree_params, OctreeParams::default());
-        let mesh = "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0.01\nresolution 8 8\n\
-                    f 1 1 1 1 0 0 0 1\np 3\n0 0 0\n1 0 0\n0 1 0\n";
-        assert_eq!(parse_str(mesh).unwrap().octree_params.leaf_size, 8);
     }
 
     #[test]

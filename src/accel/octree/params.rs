@@ -4,7 +4,6 @@
 
 use crate::limits::{LimitError, MAX_DUPLICATION_RANGE, MAX_MEMORY_BUDGET_MIB, MAX_OCTREE_DEPTH};
 use crate::math::Aabb;
-use crate::shapes::Shape;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct OctreeParams {
@@ -46,8 +45,7 @@ impl Default for OctreeParams {
         // (benches/octree_sweep_256.md): leaf size 4 renders within 3% of
         // the fastest configuration (run-to-run noise) with half its
         // intersection tests, at most 0.33x Havran's best octree on every
-        // scene; depth 12 and leaf size 2 were slower. Meshes get leaf
-        // size 8 instead (`default_for`). The cost-driven stop
+        // scene; depth 12 and leaf size 2 were slower. The cost-driven stop
         // is on: without it the SPD generator's `shells` (1,441 nested,
         // overlapping spheres) split until the memory budget and took 2.3 s
         // at 200x150 against 0.62 s without an octree (0.07 s with the
@@ -64,48 +62,7 @@ impl Default for OctreeParams {
     }
 }
 
-/// The leaf size of meshes' octrees when the scene does not choose one.
-pub const MESH_LEAF_SIZE: u32 = 8;
-/// A scene whose bounded shapes are at least this share triangles gets
-/// [`MESH_LEAF_SIZE`].
-const MESH_TRIANGLE_SHARE: f64 = 0.9;
-
 impl OctreeParams {
-    /// The defaults, with the leaf size chosen for `shapes`: 8 where nearly
-    /// every bounded shape is a triangle, 4 otherwise. A single ray tests a
-    /// node's eight children at once against boxes of what they hold
-    /// (`wide_walk.rs`), so a leaf of up to eight triangles, each test
-    /// cheap, renders as fast as the four-reference leaves below it, which
-    /// cost two to three times the build: one sample per pixel, build +
-    /// render, 1.06 s against 0.70 s on SPD gears at 512x512, 0.70 s
-    /// against 0.43 s on the bunnies, and within noise at 16 samples.
-    /// Cones, spheres and quadrics cost several triangles' worth per test,
-    /// and smaller leaves pay for them: SPD tree renders in 0.29 s with
-    /// leaf size 4 and 0.37 s with 8 (docs/benchmarks.md, "The default
-    /// octree").
-    pub fn default_for(shapes: &[Shape]) -> Self {
-        let (mut bounded, mut triangles) = (0usize, 0usize);
-        for shape in shapes {
-            match shape {
-                Shape::Plane(_) => {}
-                Shape::Triangle(_) => {
-                    bounded += 1;
-                    triangles += 1;
-                }
-                _ => bounded += 1,
-            }
-        }
-        let meshes = bounded > 0 && triangles as f64 >= MESH_TRIANGLE_SHARE * bounded as f64;
-        Self {
-            leaf_size: if meshes {
-                MESH_LEAF_SIZE
-            } else {
-                Self::default().leaf_size
-            },
-            ..Self::default()
-        }
-    }
-
     /// Every parameter within [`crate::limits`].
     pub fn check(&self) -> Result<(), LimitError> {
         if self.max_depth > MAX_OCTREE_DEPTH {
@@ -173,48 +130,4 @@ pub struct OctreeCell {
     /// Primitive references in the cell (summed over its leaves when it
     /// stands for a subtree).
     pub references: u64,
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::math::DVec3;
-    use crate::shapes::{Plane, Sphere, Triangle};
-
-    #[test]
-    fn meshes_get_larger_leaves_than_other_shapes() {
-        let triangle = || {
-            Shape::Triangle(
-                Triangle::new([DVec3::ZERO, DVec3::X, DVec3::Y]).expect("a proper triangle"),
-            )
-        };
-        let sphere = || Shape::Sphere(Sphere::new(DVec3::ZERO, 1.0));
-        let plane = || Shape::Plane(Plane::new(DVec3::ZERO, DVec3::Y));
-        let leaf = |shapes: Vec<Shape>| OctreeParams::default_for(&shapes).leaf_size;
-        let four = OctreeParams::default().leaf_size;
-        assert_eq!(four, 4);
-        assert_eq!(leaf(vec![]), four);
-        assert_eq!(leaf(vec![plane()]), four);
-        assert_eq!(leaf(vec![triangle()]), MESH_LEAF_SIZE);
-        // Planes are not in the tree: they do not count.
-        assert_eq!(leaf(vec![plane(), plane(), triangle()]), MESH_LEAF_SIZE);
-        // Nine triangles in ten is a mesh; eight in ten is not.
-        let mixed = |triangles: usize, spheres: usize| {
-            let mut shapes: Vec<Shape> = (0..triangles).map(|_| triangle()).collect();
-            shapes.extend((0..spheres).map(|_| sphere()));
-            leaf(shapes)
-        };
-        assert_eq!(mixed(9, 1), MESH_LEAF_SIZE);
-        assert_eq!(mixed(8, 2), four);
-        assert_eq!(mixed(0, 5), four);
-        // Only the leaf size depends on the shapes.
-        let chosen = OctreeParams::default_for(&[triangle()]);
-        assert_eq!(
-            chosen,
-            OctreeParams {
-                leaf_size: MESH_LEAF_SIZE,
-                ..OctreeParams::default()
-            }
-        );
-    }
 }
