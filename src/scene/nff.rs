@@ -11,6 +11,7 @@ use std::ops::Range;
 use tokens::Tokens;
 
 use super::model::{ImageSettings, Scene, SceneError};
+use crate::accel::OctreeParams;
 use crate::camera::CameraSpec;
 use crate::color::ColorConvention;
 use crate::limits::{
@@ -376,6 +377,7 @@ fn parse_into(
     }
     image.ambient = DVec3::splat(intensity);
     scene.image = image;
+    scene.octree_params = OctreeParams::default_for(&scene.shapes);
     Ok(scene)
 }
 
@@ -454,6 +456,21 @@ pp 3
         assert_eq!(s.materials.len(), 1);
         assert_eq!(s.materials[0].reflectivity, 0.3);
         assert_eq!(s.vertex_normals.len(), 1);
+        // A sphere and a cone beside three triangles: not a mesh's leaves.
+        assert_eq!(s.octree_params, OctreeParams::default());
+        // Three triangles are not a large mesh; 20,000 are.
+        let view = "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0.01\nresolution 8 8\n\
+                    f 1 1 1 1 0 0 0 1\n";
+        let triangles = |n: usize| {
+            let mut text = view.to_string();
+            for i in 0..n {
+                let x = i as f64 * 1e-3;
+                text += &format!("p 3\n{x} 0 0\n{} 0 0\n{x} 1 0\n", x + 1.0);
+            }
+            parse_str(&text).unwrap().octree_params.leaf_size
+        };
+        assert_eq!(triangles(3), 4);
+        assert_eq!(triangles(20_000), 8);
     }
 
     #[test]

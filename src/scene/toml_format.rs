@@ -403,6 +403,9 @@ pub fn parse(text: &str, path: &Path, files: &dyn FileSource) -> Result<Scene, S
     for (i, obj) in file.objects.iter().enumerate() {
         add_object(&cx, &mut scene, i, obj, files)?;
     }
+    if file.octree.leaf_size.is_none() {
+        scene.octree_params.leaf_size = OctreeParams::default_for(&scene.shapes).leaf_size;
+    }
     Ok(scene)
 }
 

@@ -260,7 +260,8 @@ pub struct OctreeArgs {
     /// Deepest octree level (root = 0; at most 21).
     #[arg(long, value_parser = octree_depth)]
     pub octree_max_depth: Option<u32>,
-    /// References up to which a node stays a leaf.
+    /// References up to which a node stays a leaf (default: 8 for a large
+    /// mesh, at least 20,000 triangles; 4 otherwise).
     #[arg(long, value_parser = parse_positive)]
     pub octree_leaf_size: Option<u32>,
     /// Let the surface-area cost estimate stop subdivision early.

@@ -191,3 +191,18 @@ fn degenerate_triangles_are_dropped_and_counted() {
     let s = parse_str(&text).unwrap();
     assert_eq!((s.shapes.len(), s.dropped_triangles), (0, 1));
 }
+
+#[test]
+fn the_leaf_size_follows_the_shapes_unless_the_file_sets_it() {
+    let triangle = "\n[[objects]]\nkind = \"triangle\"\nmaterial = \"red\"\nvertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]\n";
+    // One sphere and a few triangles: not a large mesh.
+    assert_eq!(parse_str(GOOD).unwrap().octree_params.leaf_size, 4);
+    let small = format!("{GOOD}{}", triangle.repeat(12));
+    assert_eq!(parse_str(&small).unwrap().octree_params.leaf_size, 4);
+    // The sphere and 20,000 triangles: a large mesh.
+    let mesh = format!("{GOOD}{}", triangle.repeat(20_000));
+    assert_eq!(parse_str(&mesh).unwrap().octree_params.leaf_size, 8);
+    // A leaf size the file chooses is kept, even the other default.
+    let chosen = format!("{mesh}\n[octree]\nleaf_size = 4\n");
+    assert_eq!(parse_str(&chosen).unwrap().octree_params.leaf_size, 4);
+}
