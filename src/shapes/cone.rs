@@ -4,6 +4,9 @@
 use super::hit::{Crossings, ShapeHit, Surface, unit_or_none};
 use crate::math::{Aabb, DVec3, Ray, solve_quadratic_half};
 
+/// Relative margin of the early miss test in `Cone::roots`.
+const MISS_MARGIN: f64 = 1e-9;
+
 /// Open truncated cone (or cylinder) between two disks, without end caps:
 /// NFF's `c` primitive. The radius varies linearly from `base_radius` at
 /// `base` to `apex_radius` at `apex`.
@@ -57,8 +60,19 @@ impl Cone {
     /// segment's middle: a cone can be far longer than the ray is long.
     #[inline]
     fn roots(&self, ray: &Ray) -> Option<((f64, f64), impl Fn(f64) -> bool)> {
-        let shift = self.nearest_to_axis(ray);
+        let (shift, along) = self.nearest_to_axis(ray);
         let o = (ray.origin + shift * ray.dir) - self.base;
+        // A line that passes the axis segment farther off than the widest
+        // radius misses the finite part: most lines the octree sends here
+        // do, and this costs a few products instead of the quadratic. The
+        // margin is far above what rounding of the re-based values (the
+        // ones the quadratic would use) can move a hit.
+        let gap = o - along * self.axis;
+        let widest = self.base_radius.max(self.apex_radius);
+        let margin = MISS_MARGIN * (widest + o.length() + self.height);
+        if gap.length() > widest + margin {
+            return None;
+        }
         let (oz, dz) = (o.dot(self.axis), ray.dir.dot(self.axis));
         let o_perp = o - oz * self.axis;
         let d_perp = ray.dir - dz * self.axis;
@@ -79,9 +93,11 @@ impl Cone {
 
     /// The parameter of the ray's point nearest the axis segment (closest
     /// points of a line and a segment: the segment's parameter clamped to
-    /// it, then the line's nearest to that point); 0 if not finite.
+    /// it, then the line's nearest to that point; 0 if not finite), and
+    /// that segment parameter (NaN where the line's is not finite, so
+    /// that no gap computed from it rules a hit out).
     #[inline]
-    fn nearest_to_axis(&self, ray: &Ray) -> f64 {
+    fn nearest_to_axis(&self, ray: &Ray) -> (f64, f64) {
         let w = ray.origin - self.base;
         let (dd, da) = (ray.dir.length_squared(), ray.dir.dot(self.axis));
         let (dw, aw) = (ray.dir.dot(w), self.axis.dot(w));
@@ -94,7 +110,11 @@ impl Cone {
         };
         let s = s.clamp(0.0, self.height);
         let t = (da * s - dw) / dd;
-        if t.is_finite() { t } else { 0.0 }
+        if t.is_finite() {
+            (t, s)
+        } else {
+            (0.0, f64::NAN)
+        }
     }
 
     #[inline]
