@@ -67,10 +67,12 @@ impl Cone {
         // do, and this costs a few products instead of the quadratic. The
         // margin is far above what rounding of the re-based values (the
         // ones the quadratic would use) can move a hit.
+        // Squared lengths and the 1-norm of `o` (at least its length):
+        // no square roots for a test most calls end at.
         let gap = o - along * self.axis;
         let widest = self.base_radius.max(self.apex_radius);
-        let margin = MISS_MARGIN * (widest + o.length() + self.height);
-        if gap.length() > widest + margin {
+        let reach = widest + MISS_MARGIN * (widest + o.abs().element_sum() + self.height);
+        if gap.length_squared() > reach * reach {
             return None;
         }
         let (oz, dz) = (o.dot(self.axis), ray.dir.dot(self.axis));

@@ -76,29 +76,24 @@ impl OctreeParams {
     /// mesh (at least 20,000 triangles, nine bounded shapes in ten), 4
     /// otherwise. A single ray tests a node's eight children at once
     /// against boxes of what they hold (`wide_walk.rs`), so on a large
-    /// mesh leaves of up to eight triangles render in about the time of
-    /// the four-reference leaves below them (0.92-1.02 of it on the
-    /// bunnies and SPD gears), which cost three times the build and the
-    /// memory: the bunnies' tree builds in 0.17 s instead of 0.48 s, gears'
-    /// takes 43 MiB instead of 127. On smaller meshes the build is cheap
-    /// and leaves of eight cost the packets' walk, which tests every
-    /// triangle of a leaf it enters: the bunny alone renders 11 % slower
-    /// at 16 samples, tetra 22 %. Cones, spheres and quadrics cost several
-    /// triangles' worth per test, so mixed scenes keep 4 (SPD tree renders
-    /// 32 % slower with 8). Figures: docs/benchmarks.md, "The default
-    /// octree".
+    /// mesh leaves of up to eight triangles render nearly as fast as the
+    /// four-reference leaves below them (3-4 % slower at 16 samples on
+    /// the bunnies and SPD gears), which cost three times the build and
+    /// twice the memory: the bunnies' tree builds in 0.17 s instead of
+    /// 0.49 s, gears' in 0.27 s instead of 0.75 s. On smaller meshes the
+    /// build is cheap and leaves of eight cost the packets' walk, which
+    /// tests every triangle of a leaf it enters: the bunny alone renders
+    /// 11 % slower at 16 samples, tetra 22 %. Cones, spheres and quadrics
+    /// cost several triangles' worth per test, so mixed scenes keep 4 (SPD
+    /// tree renders 32 % slower with 8). Figures: docs/benchmarks.md,
+    /// "Leaves of eight for large meshes".
     pub fn default_for(shapes: &[Shape]) -> Self {
-        let (mut bounded, mut triangles) = (0usize, 0usize);
-        for shape in shapes {
-            match shape {
-                Shape::Plane(_) => {}
-                Shape::Triangle(_) => {
-                    bounded += 1;
-                    triangles += 1;
-                }
-                _ => bounded += 1,
-            }
-        }
+        // Only bounded shapes go into the tree (planes are tested apart).
+        let bounded = shapes.iter().filter(|s| s.bounds().is_some()).count();
+        let triangles = shapes
+            .iter()
+            .filter(|s| matches!(s, Shape::Triangle(_)))
+            .count();
         let large_mesh = triangles >= MESH_MIN_TRIANGLES
             && triangles as f64 >= MESH_TRIANGLE_SHARE * bounded as f64;
         Self {
