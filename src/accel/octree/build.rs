@@ -171,6 +171,18 @@ const PENDING_BYTES: u64 = std::mem::size_of::<Pending>() as u64 + 32;
 /// separate one level further down, coincident triangles never do.
 const MAX_NON_SEPARATING_SPLITS: u8 = 2;
 
+/// A node whose references are at most this many triangles around one
+/// mesh vertex inside it stays a leaf. Every child holding the vertex
+/// would hold the whole fan again, so only the maximum depth stopped such
+/// a node: around each vertex of valence 6 the tree went ten levels down
+/// (23 references per triangle on the bunny, 51 on SPD tetra), builds took
+/// 3-5x as long and the trees 3-4x the memory, and no ray got faster
+/// (docs/benchmarks.md, "Vertex fans"). Mesh vertices have 5-7 triangles
+/// around them, up to 12 on the bunny; larger fans (a polygon cut into a
+/// fan, a sphere's pole) are cut by the cells around them and split as
+/// before.
+const MAX_FAN: usize = 16;
+
 /// A node waiting for its verdict: its slot in `nodes`, its cell, the
 /// shapes whose surface touches it, and how many of its ancestors in a row
 /// split without separating anything.
@@ -316,6 +328,9 @@ impl Builder<'_> {
         let params = &self.params;
         let leaf = Proposal::Leaf(LeafReason::Done);
         if depth >= params.max_depth || n <= params.leaf_size as usize {
+            return Ok(leaf);
+        }
+        if n <= MAX_FAN && is_vertex_fan(self.shapes, &p.items, &classify_box(&p.cell)) {
             return Ok(leaf);
         }
         // The smallest possible split (one child node) must fit.
@@ -471,4 +486,22 @@ impl Builder<'_> {
         self.used -= PENDING_BYTES;
         Ok(())
     }
+}
+
+/// Whether every reference is a triangle with one vertex, inside `cell`,
+/// in common (exactly: meshes and polygon fans share vertices by value).
+fn is_vertex_fan(shapes: &[Shape], items: &[u32], cell: &Aabb) -> bool {
+    let vertices = |i: &u32| match &shapes[*i as usize] {
+        Shape::Triangle(t) => Some(t.vertices),
+        _ => None,
+    };
+    let Some(first) = items.first().and_then(vertices) else {
+        return false;
+    };
+    first.iter().any(|v| {
+        cell.contains(*v)
+            && items[1..]
+                .iter()
+                .all(|i| vertices(i).is_some_and(|t| t.contains(v)))
+    })
 }

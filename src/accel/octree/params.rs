@@ -78,9 +78,10 @@ impl OctreeParams {
     /// against boxes of what they hold (`wide_walk.rs`), so on a large
     /// mesh leaves of up to eight triangles render nearly as fast as the
     /// four-reference leaves below them (3-4 % slower at 16 samples on
-    /// the bunnies and SPD gears), which cost three times the build and
-    /// twice the memory: the bunnies' tree builds in 0.17 s instead of
-    /// 0.49 s, gears' in 0.27 s instead of 0.75 s. On smaller meshes the
+    /// the bunnies and SPD gears), which cost two to three times the
+    /// build and twice the memory: the bunnies' tree builds in 0.08 s
+    /// instead of 0.14 s, gears' in 0.14 s instead of 0.38 s (vertex fans
+    /// kept as leaves either way, `build.rs`). On smaller meshes the
     /// build is cheap and leaves of eight cost the packets' walk, which
     /// tests every triangle of a leaf it enters: the bunny alone renders
     /// 11 % slower at 16 samples, tetra 22 %. Cones, spheres and quadrics

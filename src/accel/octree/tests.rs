@@ -370,3 +370,79 @@ fn a_small_model_far_from_the_origin_gets_the_tree_it_gets_at_the_origin() {
     );
     assert_eq!(far.leaves_stopped_by_budget, 0);
 }
+
+/// `count` triangles around `centre` in a tilted plane, a unit away.
+fn vertex_fan(centre: DVec3, count: usize) -> Vec<Shape> {
+    let (u, v) = (DVec3::new(1.0, 0.2, 0.1), DVec3::new(-0.1, 0.3, 1.0));
+    let rim = |k: usize| {
+        let a = std::f64::consts::TAU * k as f64 / count as f64;
+        centre + a.cos() * u + a.sin() * v
+    };
+    (0..count)
+        .filter_map(|k| crate::shapes::Triangle::new([centre, rim(k), rim(k + 1)]))
+        .map(Shape::Triangle)
+        .collect()
+}
+
+#[test]
+fn a_vertex_fan_stays_a_leaf_and_a_larger_fan_splits_as_before() {
+    // Two fans of six triangles, as around a mesh vertex: once the fans
+    // are apart, the cell around each vertex holds all six, and every child
+    // holding the vertex would again.
+    let centres = [DVec3::new(0.31, 0.17, 0.05), DVec3::new(4.13, 2.71, 1.09)];
+    let shapes: Vec<Shape> = centres.iter().flat_map(|&c| vertex_fan(c, 6)).collect();
+    // Without the cost-driven stop, which could stop these small trees too.
+    let params = OctreeParams {
+        cost_driven: false,
+        ..OctreeParams::default()
+    };
+    let tree = Octree::build(&shapes, params).unwrap();
+    for (cell, refs) in leaves(&tree) {
+        assert!(refs.len() <= 6, "a leaf of {} references", refs.len());
+        assert!(
+            cell.side > tree.root_cell().side / 64.0,
+            "a leaf at side {}",
+            cell.side
+        );
+    }
+    assert!(
+        tree.stats().max_depth < 6,
+        "depth {}",
+        tree.stats().max_depth
+    );
+    // A polygon of 40 triangles cut into a fan (more than `MAX_FAN`): the
+    // cells around it take its triangles apart, down to the maximum depth
+    // at the centre as before.
+    let tree = Octree::build(&vertex_fan(centres[0], 40), params).unwrap();
+    assert_eq!(tree.stats().max_depth, params.max_depth);
+    // The walk answers as brute force, through the fans' leaves.
+    let tree = Octree::build(&shapes, params).unwrap();
+    let prims = Primitives::opaque(&shapes);
+    let mut hits = 0;
+    for centre in centres {
+        for k in 0..64 {
+            let offset = DVec3::new(
+                (k % 8) as f64 * 0.25 - 1.0,
+                0.0,
+                (k / 8) as f64 * 0.25 - 1.0,
+            );
+            let ray = PreparedRay::new(Ray::new(
+                centre + offset - DVec3::new(0.0, 3.0, 0.0),
+                DVec3::new(0.01, 1.0, 0.02).normalize(),
+            ));
+            let octree = tree.closest(
+                &prims,
+                &ray,
+                f64::INFINITY,
+                &mut super::WalkStack::default(),
+                &mut NoCounts,
+            );
+            assert_eq!(
+                octree,
+                closest_brute_force(&prims, &ray, f64::INFINITY, &mut NoCounts)
+            );
+            hits += octree.is_some() as usize;
+        }
+    }
+    assert!(hits > 32, "{hits} hits");
+}
