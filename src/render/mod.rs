@@ -28,7 +28,7 @@ pub use passes::{
 pub use renderer::{RenderError, Renderer};
 pub use unit_costs::{
     OctreeCandidate, Prediction, RAY_SAMPLE_SIDE, RaySample, SUGGESTION_DEPTHS,
-    SUGGESTION_LEAF_SIZES, UnitCosts, random_lines, sample_rays, suggest_octree,
+    SUGGESTION_LEAF_SIZES, UnitCosts, random_lines, sample_rays, sample_rays_with, suggest_octree,
 };
 
 #[cfg(test)]

@@ -164,16 +164,30 @@ pub struct RaySample {
     /// The sample rendered as the render runs (packets where the SIMD
     /// level has them, no counting), on one thread, the fastest of three.
     pub seconds_per_ray: f64,
+    /// The time per ray of the sample at twice its side over the sample's
+    /// own: a larger image's rays are more coherent (packets diverge less,
+    /// neighbours share cache lines), so each doubling of the side costs
+    /// less per ray (1 where the render is no larger than the sample).
+    pub per_doubling: f64,
+    /// Doublings from the sample's side to the render's, the render's
+    /// side taken times the square root of its samples per pixel (their
+    /// rays are as close as a larger image's).
+    pub doublings: f64,
 }
 
 impl RaySample {
+    /// The sample's time per ray carried to the render's size.
+    pub fn seconds_per_ray_at_render(&self) -> f64 {
+        self.seconds_per_ray * self.per_doubling.powf(self.doublings)
+    }
+
     /// A render of `rays` rays on `threads` threads (taken as scaling
     /// perfectly), at the sample's time per ray.
     pub fn predict(&self, rays: u64, threads: usize) -> Prediction {
         Prediction {
             traversal_steps_per_ray: self.traversal_steps_per_ray,
             intersection_tests_per_ray: self.intersection_tests_per_ray,
-            render_s: rays as f64 * self.seconds_per_ray / threads.max(1) as f64,
+            render_s: rays as f64 * self.seconds_per_ray_at_render() / threads.max(1) as f64,
         }
     }
 }
@@ -189,19 +203,61 @@ impl RaySample {
 /// than the render's, so edges weigh a little more. The counts are the
 /// same on any number of threads; the time is taken on one.
 pub fn sample_rays(renderer: &Renderer, octree: &Octree) -> Result<RaySample, RenderError> {
+    sample_rays_with(renderer, octree, None)
+}
+
+/// Bounds on [`RaySample::per_doubling`], against timing noise.
+const PER_DOUBLING_RANGE: (f64, f64) = (0.5, 1.0);
+
+/// [`sample_rays`], with the time per ray's change per doubling of the
+/// side given (measured once for a scene and view, it holds for its other
+/// trees: [`suggest_octree`]) or, when `None`, measured on a second
+/// thumbnail at twice the side.
+pub fn sample_rays_with(
+    renderer: &Renderer,
+    octree: &Octree,
+    per_doubling: Option<f64>,
+) -> Result<RaySample, RenderError> {
     let thumbnail = thumbnail(renderer, octree, RAY_SAMPLE_SIDE)?;
-    let on_one_thread = on_one_thread(&thumbnail);
-    let counts = on_one_thread(true);
-    let seconds = fastest_of_3(|| {
-        on_one_thread(false);
-    });
+    let seconds_per_ray = |thumbnail: &Renderer| {
+        let on_one_thread = on_one_thread(thumbnail);
+        let mut rays = 0;
+        let seconds = fastest_of_3(|| {
+            rays = on_one_thread(false).rays.total();
+        });
+        seconds / rays.max(1) as f64
+    };
+    let counts = on_one_thread(&thumbnail)(true);
     let rays = counts.rays.total();
     let per_ray = |x: u64| x as f64 / rays.max(1) as f64;
+    let side = |s: &crate::settings::RenderSettings| s.width.max(s.height) as f64;
+    let render_side = side(&renderer.settings) * (renderer.settings.samples.max(1) as f64).sqrt();
+    let doublings = (render_side / side(&thumbnail.settings)).log2().max(0.0);
+    let seconds = seconds_per_ray(&thumbnail);
+    let per_doubling = match per_doubling {
+        Some(p) => p,
+        None if doublings > 0.0 => {
+            // Twice the side, or the render's own if that is smaller.
+            let larger = self::thumbnail(renderer, octree, 2 * RAY_SAMPLE_SIDE)?;
+            let steps = (side(&larger.settings) / side(&thumbnail.settings)).log2();
+            if steps < 0.5 {
+                1.0
+            } else {
+                let ratio = seconds_per_ray(&larger) / seconds.max(f64::MIN_POSITIVE);
+                ratio
+                    .powf(1.0 / steps)
+                    .clamp(PER_DOUBLING_RANGE.0, PER_DOUBLING_RANGE.1)
+            }
+        }
+        None => 1.0,
+    };
     Ok(RaySample {
         rays,
         traversal_steps_per_ray: per_ray(counts.work.traversal_steps),
         intersection_tests_per_ray: per_ray(counts.work.intersection_tests),
-        seconds_per_ray: seconds / rays.max(1) as f64,
+        seconds_per_ray: seconds,
+        per_doubling,
+        doublings,
     })
 }
 
@@ -295,6 +351,7 @@ pub fn suggest_octree(
 ) -> Option<(Vec<OctreeCandidate>, usize)> {
     let base = renderer.scene.octree_params;
     let mut candidates = Vec::new();
+    let mut per_doubling = None;
     for max_depth in SUGGESTION_DEPTHS {
         for leaf_size in SUGGESTION_LEAF_SIZES {
             if !keep_going() {
@@ -311,9 +368,11 @@ pub fn suggest_octree(
                 continue;
             };
             let build_s = start.elapsed().as_secs_f64();
-            let Ok(sample) = sample_rays(renderer, &octree) else {
+            let Ok(sample) = sample_rays_with(renderer, &octree, per_doubling) else {
                 continue;
             };
+            // Measured on the first tree, it holds for the others.
+            per_doubling = Some(sample.per_doubling);
             candidates.push(OctreeCandidate {
                 params,
                 build_s,
@@ -392,6 +451,32 @@ mod tests {
             counts.work.intersection_tests as f64 / rays
         );
         assert!(sample.intersection_tests_per_ray > 0.0);
+        // Nothing to carry to a larger size.
+        assert_eq!((sample.doublings, sample.per_doubling), (0.0, 1.0));
+        assert_eq!(sample.seconds_per_ray_at_render(), sample.seconds_per_ray);
+    }
+
+    #[test]
+    fn the_ray_sample_is_carried_to_the_render_size_by_the_doublings_of_its_side() {
+        // 320 pixels a side is 320 / 64 = 5 times the sample's, and 16
+        // samples per pixel are 4 times more rays a side again.
+        let scene = lattice(DVec3::new(3.0, 4.0, 12.0), DVec3::ZERO, 320, 240);
+        let octree = scene.build_octree().unwrap();
+        let mut settings = scene.render_settings();
+        settings.samples = 16;
+        let renderer = Renderer::new(&scene, &octree, settings).unwrap();
+        let sample = sample_rays(&renderer, &octree).unwrap();
+        assert!(
+            (sample.doublings - 20f64.log2()).abs() < 1e-12,
+            "{sample:?}"
+        );
+        assert!((0.5..=1.0).contains(&sample.per_doubling), "{sample:?}");
+        let carried = sample.seconds_per_ray * sample.per_doubling.powf(sample.doublings);
+        assert_eq!(sample.seconds_per_ray_at_render(), carried);
+        assert_eq!(sample.predict(1000, 2).render_s, 1000.0 * carried / 2.0);
+        // A factor given is used as given.
+        let given = sample_rays_with(&renderer, &octree, Some(0.75)).unwrap();
+        assert_eq!(given.per_doubling, 0.75);
     }
 
     #[test]

@@ -338,10 +338,17 @@ fn sweep(args: &BenchArgs) -> Result<()> {
         let mut settings = bench_settings(args, &mut scene);
         settings.use_octree = true;
         say!("sweep {}", path.display());
-        // Unit costs once per scene, on its own octree setting.
-        let unit_costs = {
+        // Unit costs once per scene, on its own octree setting, and how
+        // the time per ray changes with the image's size (the scene's and
+        // view's, as "Suggest a setting" takes it).
+        let (unit_costs, per_doubling) = {
             let octree = pool.install(|| scene.build_octree())?;
-            UnitCosts::measure(&Renderer::new(&scene, &octree, settings)?, &octree)?
+            let renderer = Renderer::new(&scene, &octree, settings)?;
+            let sample = glint::render::sample_rays(&renderer, &octree)?;
+            (
+                UnitCosts::measure(&renderer, &octree)?,
+                Some(sample.per_doubling),
+            )
         };
         let first_row = rows.len();
         let duplications = if args.sweep_max_duplications.is_empty() {
@@ -399,7 +406,7 @@ fn sweep(args: &BenchArgs) -> Result<()> {
             // (the ray count, which the octree does not change, excepted).
             let predicted_cost = octree.predicted_cost();
             let renderer = Renderer::new(&scene, &octree, settings)?;
-            let ray_sample = glint::render::sample_rays(&renderer, &octree)?;
+            let ray_sample = glint::render::sample_rays_with(&renderer, &octree, per_doubling)?;
             let counts = pool.install(|| renderer.render(true, None).1);
             for _ in 0..args.repeat {
                 renders.push(timed(|| pool.install(|| renderer.render(false, None))).1);
