@@ -307,7 +307,7 @@ impl Renderer<'_> {
         query: &mut Query<C>,
         stack: &mut PacketScratch<N>,
     ) -> [Option<ClosestHit>; N] {
-        if self.packets_through_octree()
+        if self.packets_through_octree::<C>()
             && let Some(packet) = RayPacket::<N>::from_rays(rays)
         {
             let prims = self.primitives();

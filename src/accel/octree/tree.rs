@@ -37,6 +37,12 @@ impl Octree {
         self.bounds
     }
 
+    /// Whether the whole tree is one leaf (a scene of a few shapes, or a
+    /// build stopped at the root).
+    pub fn is_one_leaf(&self) -> bool {
+        self.nodes.len() <= 1
+    }
+
     /// The cells to draw for an overlay down to level `depth`: every
     /// non-empty leaf above that level, and every non-empty node at it
     /// (standing for its subtree), with the references beneath it.
