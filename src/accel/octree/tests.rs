@@ -34,6 +34,24 @@ fn leaves(tree: &Octree) -> Vec<(Cell, Vec<u32>)> {
     out
 }
 
+/// The tree's closest hit along `ray`, checked against brute force.
+fn closest_as_brute_force(
+    tree: &Octree,
+    prims: &Primitives,
+    ray: &PreparedRay,
+) -> Option<crate::accel::ClosestHit> {
+    let octree = tree.closest(
+        prims,
+        ray,
+        f64::INFINITY,
+        &mut super::WalkStack::default(),
+        &mut NoCounts,
+    );
+    let brute = closest_brute_force(prims, ray, f64::INFINITY, &mut NoCounts);
+    assert_eq!(octree, brute, "{:?}", ray.ray);
+    octree
+}
+
 #[test]
 fn an_interior_node_finds_its_children_by_counting_octants_below() {
     // Octants 0, 2, 5 and 7 hold something, stored from node 10 on.
@@ -168,15 +186,7 @@ fn rays_in_split_planes_parallel_to_axes_and_through_corners_agree_with_brute_fo
     let (mut a, mut b) = (ShadowCrossings::default(), ShadowCrossings::default());
     for ray in rays {
         let ray = PreparedRay::new(ray);
-        let octree = tree.closest(
-            &prims,
-            &ray,
-            f64::INFINITY,
-            &mut super::WalkStack::default(),
-            &mut NoCounts,
-        );
-        let brute = closest_brute_force(&prims, &ray, f64::INFINITY, &mut NoCounts);
-        assert_eq!(octree, brute, "{:?}", ray.ray);
+        let octree = closest_as_brute_force(&tree, &prims, &ray);
         hits += octree.is_some() as usize;
         tree.occlusion(
             &prims,
@@ -430,18 +440,7 @@ fn a_vertex_fan_stays_a_leaf_and_a_larger_fan_splits_as_before() {
                 centre + offset - DVec3::new(0.0, 3.0, 0.0),
                 DVec3::new(0.01, 1.0, 0.02).normalize(),
             ));
-            let octree = tree.closest(
-                &prims,
-                &ray,
-                f64::INFINITY,
-                &mut super::WalkStack::default(),
-                &mut NoCounts,
-            );
-            assert_eq!(
-                octree,
-                closest_brute_force(&prims, &ray, f64::INFINITY, &mut NoCounts)
-            );
-            hits += octree.is_some() as usize;
+            hits += closest_as_brute_force(&tree, &prims, &ray).is_some() as usize;
         }
     }
     assert!(hits > 32, "{hits} hits");
