@@ -150,6 +150,27 @@ impl pulp::WithSimd for BvhQuery<'_> {
 /// far below any thickness a scene models.
 const SAME_SURFACE_RELATIVE: f64 = 1e-9;
 
+/// Where a renderer sends its ray queries.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Route {
+    Bvh,
+    Octree,
+    BruteForce,
+}
+
+/// Where counted and uncounted queries go, decided once per renderer so a
+/// query pays one branch, as brute force does: on a two-shape scene the
+/// per-query checks of settings and tree were most of what the octree's
+/// whole run cost above brute force's.
+#[derive(Clone, Copy, Debug)]
+struct Routes {
+    counted: Route,
+    uncounted: Route,
+    /// Whether eye rays go through the octree's packet walk, likewise.
+    counted_packets: bool,
+    uncounted_packets: bool,
+}
+
 /// A scene prepared for rendering with fixed settings.
 pub struct Renderer<'a> {
     pub(super) scene: &'a Scene,
@@ -157,6 +178,7 @@ pub struct Renderer<'a> {
     /// When given, every query goes through it instead of the octree or
     /// brute force ([`Renderer::with_bvh`]).
     bvh: Option<&'a Bvh>,
+    routes: Routes,
     pub(super) settings: RenderSettings,
     pub(super) camera: Camera,
     /// What `camera` was made from (a thumbnail of the same view needs it).
@@ -177,6 +199,34 @@ pub struct Renderer<'a> {
     pub(super) simd: SimdLevel,
     /// Where single rays' octree queries run (AVX2 or baseline code).
     pub(super) single_rays: SingleRays,
+}
+
+impl Routes {
+    fn new(settings: &RenderSettings, octree: &Octree, has_bvh: bool) -> Self {
+        // A tree that is one leaf (a scene of a few shapes) holds every
+        // bounded shape, so its walk tests what brute force tests, after
+        // the root's box, the walk's setup and, for eye rays, the packets'
+        // lanes: uncounted queries go brute force there (the same hits, by
+        // the octree's identity with brute force). Counted queries still
+        // walk it, so Havran's counts stay the tree's.
+        let route = |counts: bool| {
+            if has_bvh && settings.accel() == Accel::Bvh {
+                Route::Bvh
+            } else if settings.use_octree && (counts || !octree.is_one_leaf()) {
+                Route::Octree
+            } else {
+                Route::BruteForce
+            }
+        };
+        let packets =
+            |counts: bool| settings.accel() == Accel::Octree && route(counts) == Route::Octree;
+        Self {
+            counted: route(true),
+            uncounted: route(false),
+            counted_packets: packets(true),
+            uncounted_packets: packets(false),
+        }
+    }
 }
 
 impl<'a> Renderer<'a> {
@@ -226,6 +276,7 @@ impl<'a> Renderer<'a> {
             scene,
             octree,
             bvh: None,
+            routes: Routes::new(&settings, octree, false),
             settings,
             camera,
             camera_spec,
@@ -286,29 +337,28 @@ impl<'a> Renderer<'a> {
     /// walks are the octree's).
     pub fn with_bvh(mut self, bvh: &'a Bvh) -> Self {
         self.bvh = Some(bvh);
+        self.routes = Routes::new(&self.settings, self.octree, true);
         self
     }
 
-    /// The BVH queries go through, if the settings ask for one and it was given.
-    fn bvh(&self) -> Option<&'a Bvh> {
-        self.bvh.filter(|_| self.settings.accel() == Accel::Bvh)
+    /// Where queries counted by `C` go.
+    #[inline(always)]
+    fn route<C: Counter>(&self) -> Route {
+        if C::COUNTS {
+            self.routes.counted
+        } else {
+            self.routes.uncounted
+        }
     }
 
     /// Whether eye rays (counted by `C`) go through the octree's packet walk.
+    #[inline(always)]
     pub(super) fn packets_through_octree<C: Counter>(&self) -> bool {
-        self.settings.accel() == Accel::Octree && self.walks_octree::<C>()
-    }
-
-    /// Whether queries counted by `C` walk the octree. A tree that is one
-    /// leaf (a scene of a few shapes) holds every bounded shape, so its
-    /// walk tests what brute force tests, after the root's box, the walk's
-    /// setup and, for eye rays, the packets' lanes: uncounted queries go
-    /// brute force there (the same hits, by the octree's identity with
-    /// brute force), which closes most of the millisecond the two-shape
-    /// scenes lost with the octree on. Counted queries still walk it, so
-    /// Havran's counts stay the tree's.
-    fn walks_octree<C: Counter>(&self) -> bool {
-        self.settings.use_octree && (C::COUNTS || !self.octree.is_one_leaf())
+        if C::COUNTS {
+            self.routes.counted_packets
+        } else {
+            self.routes.uncounted_packets
+        }
     }
 
     pub(super) fn primitives(&self) -> Primitives<'_> {
@@ -325,7 +375,10 @@ impl<'a> Renderer<'a> {
         query: &mut Query<C>,
     ) -> Option<ClosestHit> {
         let prims = self.primitives();
-        if let Some(bvh) = self.bvh() {
+        let route = self.route::<C>();
+        if route == Route::Bvh
+            && let Some(bvh) = self.bvh
+        {
             let stack = &mut query.scratch.bvh;
             if !C::COUNTS
                 && let Some(simd) = self.single_rays.avx2()
@@ -342,7 +395,7 @@ impl<'a> Renderer<'a> {
             }
             return bvh.closest(&prims, ray, f64::INFINITY, stack, query.counter);
         }
-        if self.walks_octree::<C>() {
+        if route == Route::Octree {
             let stack = &mut query.scratch.stack;
             if !C::COUNTS
                 && let Some(simd) = self.single_rays.avx2()
@@ -384,7 +437,10 @@ impl<'a> Renderer<'a> {
             bvh,
             crossings,
         } = &mut *query.scratch;
-        if let Some(tree) = self.bvh() {
+        let route = self.route::<C>();
+        if route == Route::Bvh
+            && let Some(tree) = self.bvh
+        {
             match self.single_rays.avx2() {
                 Some(simd) if !C::COUNTS => {
                     let query = BvhQuery {
@@ -399,7 +455,7 @@ impl<'a> Renderer<'a> {
                 }
                 _ => tree.occlusion(&prims, ray, distance, crossings, bvh, query.counter),
             }
-        } else if self.walks_octree::<C>() {
+        } else if route == Route::Octree {
             match self.single_rays.avx2() {
                 Some(simd) if !C::COUNTS => pulp::Simd::vectorize(
                     simd,
@@ -467,5 +523,63 @@ impl<'a> Renderer<'a> {
         };
         self.trace(&ray, 1, &mut query, &mut rays, &mut root);
         root
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::sphere_grid;
+    use crate::scene::ImageSettings;
+    use crate::stats::WorkCounts;
+
+    fn scene_of(shapes: Vec<crate::shapes::Shape>) -> Scene {
+        let camera = CameraSpec {
+            eye: crate::math::DVec3::new(0.0, 0.0, 10.0),
+            lookat: crate::math::DVec3::ZERO,
+            up: crate::math::DVec3::Y,
+            fov: 30.0,
+        };
+        let mut scene = Scene::empty("routes".into(), camera, ImageSettings::default());
+        scene.materials = vec![Material::default()];
+        for shape in shapes {
+            scene.push(shape, 0);
+        }
+        scene
+    }
+
+    fn routes(renderer: &Renderer) -> (Route, Route, bool, bool) {
+        (
+            renderer.route::<WorkCounts>(),
+            renderer.route::<NoCounts>(),
+            renderer.packets_through_octree::<WorkCounts>(),
+            renderer.packets_through_octree::<NoCounts>(),
+        )
+    }
+
+    #[test]
+    fn a_one_leaf_tree_sends_only_counted_queries_through_the_octree() {
+        use Route::*;
+        let few = scene_of(sphere_grid(1, 0.5));
+        let many = scene_of(sphere_grid(4, 0.3));
+        for (scene, uncounted) in [(&few, BruteForce), (&many, Octree)] {
+            let octree = scene.build_octree().unwrap();
+            assert_eq!(octree.is_one_leaf(), uncounted == BruteForce);
+            let bvh = crate::accel::Bvh::build(&scene.shapes);
+            let mut settings = scene.render_settings();
+            let renderer = Renderer::new(scene, &octree, settings).unwrap();
+            let packets = uncounted == Octree;
+            assert_eq!(routes(&renderer), (Octree, uncounted, true, packets));
+            // A BVH takes every query, counted or not, and no packets;
+            // asked for but not given, the settings' octree switch decides.
+            settings.set_accel(Accel::Bvh);
+            let without = Renderer::new(scene, &octree, settings).unwrap();
+            assert_eq!(routes(&without), (BruteForce, BruteForce, false, false));
+            let with = Renderer::new(scene, &octree, settings).unwrap().with_bvh(&bvh);
+            assert_eq!(routes(&with), (Bvh, Bvh, false, false));
+            settings.set_accel(Accel::BruteForce);
+            let brute = Renderer::new(scene, &octree, settings).unwrap().with_bvh(&bvh);
+            assert_eq!(routes(&brute), (BruteForce, BruteForce, false, false));
+        }
     }
 }
