@@ -39,7 +39,8 @@ pub(super) fn classify_box(cell: &Cell) -> Aabb {
 /// Cost of one traversal step relative to one intersection test, for the
 /// surface-area estimate.
 const TRAVERSAL_COST: f64 = 1.0;
-/// Below this many references a node is classified on one thread.
+/// Below this many references a node (or a batch of nodes) is classified
+/// on one thread.
 const PARALLEL_MIN: usize = 2048;
 /// Nodes of a level are classified in batches of about this many
 /// references, so a level's candidate children never all exist at once...
@@ -310,8 +311,13 @@ impl Builder<'_> {
                     references += p.items.len();
                     batch.push(p);
                 }
-                let proposals: Vec<Result<Proposal, OctreeError>> =
-                    batch.par_iter().map(|p| self.propose(p, depth)).collect();
+                // A small batch on this thread: waking the pool's threads
+                // costs more than classifying a few hundred references.
+                let proposals: Vec<Result<Proposal, OctreeError>> = if references < PARALLEL_MIN {
+                    batch.iter().map(|p| self.propose(p, depth)).collect()
+                } else {
+                    batch.par_iter().map(|p| self.propose(p, depth)).collect()
+                };
                 for (pending, proposal) in batch.into_iter().zip(proposals) {
                     self.decide(pending, proposal?, &mut next)?;
                 }

@@ -12,7 +12,7 @@ use serde::Serialize;
 
 use crate::common::{
     AccelArg, OctreeArgs, RulesArgs, check_scene_files, load_scene, median, parse_positive,
-    parse_samples, parse_size, thread_pool,
+    parse_samples, parse_size, thread_pool_here,
 };
 
 #[derive(clap::Args)]
@@ -116,7 +116,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     if args.sweep {
         return sweep(args);
     }
-    let pool = thread_pool(args.threads)?;
+    let pool = thread_pool_here(args.threads)?;
     let mut results = Vec::new();
     for path in &args.scenes {
         let (mut scene, load_s) = load_scene(path)?;
@@ -322,7 +322,7 @@ struct SweepRow {
 }
 
 fn sweep(args: &BenchArgs) -> Result<()> {
-    let pool = thread_pool(args.threads)?;
+    let pool = thread_pool_here(args.threads)?;
     let mut rows = Vec::new();
     if args.format == Format::Markdown {
         out!(

@@ -130,6 +130,20 @@ pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool> {
         .context("cannot start the render threads")
 }
 
+/// Like [`thread_pool`], with the calling thread as one of the workers, for
+/// a command that makes one pool and waits on it: its work starts on this
+/// thread at once instead of after a new thread wakes (for a two-shape
+/// scene's octree, most of the build's time), and `threads` counts this
+/// thread too. The pool lives until the process ends.
+pub fn thread_pool_here(threads: usize) -> Result<rayon::ThreadPool> {
+    check_threads(threads)?;
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .use_current_thread()
+        .build()
+        .context("cannot start the render threads")
+}
+
 pub fn parse_samples(s: &str) -> std::result::Result<u32, String> {
     match s {
         "1" => Ok(1),

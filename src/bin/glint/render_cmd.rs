@@ -12,7 +12,7 @@ use glint::settings::{Accel, Overrides, RenderSettings, ViewMode};
 
 use crate::common::{
     AccelArg, OctreeArgs, RulesArgs, Switch, load_scene, parse_pixel, parse_positive,
-    parse_samples, thread_pool,
+    parse_samples, thread_pool_here,
 };
 
 #[derive(clap::Args)]
@@ -182,6 +182,7 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
             );
         }
     }
+    let pool = thread_pool_here(args.threads)?;
     let load_start = Instant::now();
     let mut overlay_depth = args.overlay.map(|_| {
         args.overlay_depth
@@ -223,7 +224,6 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
     overrides.accel = AccelArg::resolve(args.accel, args.octree)?.map(AccelArg::accel);
     overrides.apply(&mut settings, &mut scene.octree_params);
 
-    let pool = thread_pool(args.threads)?;
     let threads = pool.current_num_threads();
     let build_start = Instant::now();
     // A depth with no overlay to draw would be ignored without a word.
