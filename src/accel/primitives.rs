@@ -42,6 +42,16 @@ impl<'a> Primitives<'a> {
         }
     }
 
+    /// Whether shape `index` is opaque and blocks a shadow ray over
+    /// `(0, t_max)`: the test an occlusion query makes of it. `false` for
+    /// an index this scene lacks (a hint kept from another render).
+    #[inline(always)]
+    pub fn blocks(&self, index: u32, ray: &PreparedRay, t_max: f64) -> bool {
+        (index as usize) < self.shapes.len()
+            && !self.is_transparent(index)
+            && self.intersect(index, ray, t_max).is_some()
+    }
+
     #[inline(always)]
     pub(crate) fn is_transparent(&self, index: u32) -> bool {
         self.transparent.get(index as usize) == Some(&true)
@@ -158,6 +168,10 @@ pub const MAX_SHADOW_CROSSINGS: usize = 32;
 #[derive(Clone)]
 pub struct ShadowCrossings {
     blocked: bool,
+    /// The opaque shape that blocked the ray, when `blocked`. Which one
+    /// depends on the order shapes were tested in, so it is not part of
+    /// the answer (nor of equality): only a hint for the next ray.
+    blocker: u32,
     len: usize,
     hits: [(f64, u32); MAX_SHADOW_CROSSINGS],
 }
@@ -166,6 +180,7 @@ impl Default for ShadowCrossings {
     fn default() -> Self {
         Self {
             blocked: false,
+            blocker: 0,
             len: 0,
             hits: [(0.0, 0); MAX_SHADOW_CROSSINGS],
         }
@@ -199,6 +214,12 @@ impl ShadowCrossings {
 
     pub fn is_blocked(&self) -> bool {
         self.blocked
+    }
+
+    /// The opaque shape that blocked the ray (one of them: which depends on
+    /// the order of the tests), if it was blocked.
+    pub fn blocker(&self) -> Option<u32> {
+        self.blocked.then_some(self.blocker)
     }
 
     /// Transparent crossings, nearest first (empty when blocked).
@@ -248,6 +269,7 @@ pub(crate) fn test_occlusion<C: Counter>(
         counter.tested(index, hit.map(|h| h.t));
         if hit.is_some() {
             found.blocked = true;
+            found.blocker = index;
         }
         return found.blocked;
     }

@@ -174,7 +174,7 @@ impl Renderer<'_> {
             let pass = if self.settings.shadows {
                 rays.shadow += 1;
                 let shadow = PreparedRay::new(Ray::new(shadow_origin, l));
-                self.transmittance(&shadow, distance, query)
+                self.transmittance(&shadow, distance, index, query)
             } else {
                 1.0
             };

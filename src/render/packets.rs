@@ -436,7 +436,7 @@ impl Renderer<'_> {
                     .and_then(|at| self.toward_light(at, origins[k], light))
             });
             let passes = if self.settings.shadows {
-                self.transmittance_lanes(&origins, &toward, query, ray_counts)
+                self.transmittance_lanes(&origins, &toward, index, query, ray_counts)
             } else {
                 [1.0; N]
             };
@@ -581,6 +581,7 @@ impl Renderer<'_> {
         &self,
         origins: &[DVec3; N],
         toward: &[Option<(DVec3, f64, f64)>; N],
+        light: usize,
         query: &mut Query<C>,
         ray_counts: &mut RayCounts,
     ) -> [f64; N] {
@@ -589,7 +590,7 @@ impl Renderer<'_> {
             if let Some((l, distance, _)) = toward[k] {
                 ray_counts.shadow += 1;
                 let ray = PreparedRay::new(Ray::new(origins[k], l));
-                passes[k] = self.transmittance(&ray, distance, query);
+                passes[k] = self.transmittance(&ray, distance, light, query);
             }
         }
         passes
