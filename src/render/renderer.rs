@@ -41,6 +41,7 @@ pub enum RenderError {
 /// Scratch space for ray queries: the octree walk's and the BVH's stacks
 /// and a shadow ray's crossings. One per tile (or per inspected pixel), so
 /// no ray sets them up.
+#[derive(Default)]
 pub struct Scratch {
     stack: WalkStack,
     bvh: BvhStack,
@@ -50,17 +51,6 @@ pub struct Scratch {
     /// has paid: neighbouring shadow rays are often blocked by the same
     /// shape (Haines and Greenberg 1986, the shadow cache).
     hints: [ShadowHint; HINTED_LIGHTS],
-}
-
-impl Default for Scratch {
-    fn default() -> Self {
-        Self {
-            stack: WalkStack::default(),
-            bvh: BvhStack::default(),
-            crossings: ShadowCrossings::default(),
-            hints: [ShadowHint::NONE; HINTED_LIGHTS],
-        }
-    }
 }
 
 /// Scenes of at most this many shapes keep no [`ShadowHint`]s.
@@ -84,11 +74,17 @@ struct ShadowHint {
     score: i32,
 }
 
+impl Default for ShadowHint {
+    /// No shape yet (no index is `u32::MAX`), tested on the first ray.
+    fn default() -> Self {
+        Self {
+            shape: u32::MAX,
+            score: 0,
+        }
+    }
+}
+
 impl ShadowHint {
-    const NONE: Self = Self {
-        shape: u32::MAX,
-        score: 0,
-    };
     const HIT: i32 = 8;
     /// Bounds that let the score turn within a few dozen rays when the
     /// blocking shapes change (a tile moving onto a mesh, say).
@@ -626,9 +622,9 @@ mod tests {
 
     fn scene_of(shapes: Vec<crate::shapes::Shape>) -> Scene {
         let camera = CameraSpec {
-            eye: crate::math::DVec3::new(0.0, 0.0, 10.0),
-            lookat: crate::math::DVec3::ZERO,
-            up: crate::math::DVec3::Y,
+            eye: DVec3::new(0.0, 0.0, 10.0),
+            lookat: DVec3::ZERO,
+            up: DVec3::Y,
             fov: 30.0,
         };
         let mut scene = Scene::empty("routes".into(), camera, ImageSettings::default());

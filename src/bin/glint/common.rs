@@ -123,8 +123,12 @@ pub fn check_threads(threads: usize) -> Result<()> {
 /// A rayon pool with `threads` workers (0 = one per core), at most
 /// [`MAX_THREADS_PER_CORE`] per core.
 pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool> {
+    build_pool(threads, rayon::ThreadPoolBuilder::new())
+}
+
+fn build_pool(threads: usize, builder: rayon::ThreadPoolBuilder) -> Result<rayon::ThreadPool> {
     check_threads(threads)?;
-    rayon::ThreadPoolBuilder::new()
+    builder
         .num_threads(threads)
         .build()
         .context("cannot start the render threads")
@@ -136,12 +140,10 @@ pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool> {
 /// scene's octree, most of the build's time), and `threads` counts this
 /// thread too. The pool lives until the process ends.
 pub fn thread_pool_here(threads: usize) -> Result<rayon::ThreadPool> {
-    check_threads(threads)?;
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .use_current_thread()
-        .build()
-        .context("cannot start the render threads")
+    build_pool(
+        threads,
+        rayon::ThreadPoolBuilder::new().use_current_thread(),
+    )
 }
 
 pub fn parse_samples(s: &str) -> std::result::Result<u32, String> {
