@@ -5,7 +5,10 @@
 //! let scene = glint::scene::load(std::path::Path::new("scenes/sphere.toml"))?;
 //! let octree = scene.build_octree()?;
 //! let settings = scene.render_settings();
-//! let renderer = glint::render::Renderer::new(&scene, &octree, settings)?;
+//! // Optional: shadow rays ask it which shapes they can meet first.
+//! let light_buffer = scene.build_light_buffer();
+//! let renderer = glint::render::Renderer::new(&scene, &octree, settings)?
+//!     .with_light_buffer(light_buffer.as_ref());
 //! let (frame, _counts) = renderer.render(false, None);
 //! glint::export::save_png(&frame, std::path::Path::new("sphere.png"), None)?;
 //! # Ok::<(), Box<dyn std::error::Error>>(())

@@ -95,10 +95,15 @@ pub fn check_scene(scene: &mut Scene) {
     settings.samples = 1;
     settings.adaptive = false;
     settings.max_depth = settings.max_depth.min(4);
+    // The octree's render asks the light buffer too: its answers must be
+    // brute force's.
+    let light_buffer = scene.build_light_buffer();
     let render = |use_octree: bool| {
         let mut s = settings;
         s.use_octree = use_octree;
-        let renderer = Renderer::new(scene, &octree, s).ok()?;
+        let renderer = Renderer::new(scene, &octree, s)
+            .ok()?
+            .with_light_buffer(light_buffer.as_ref());
         Some(single_thread(|| renderer.render(false, None)).0)
     };
     let Some(on) = render(true) else {

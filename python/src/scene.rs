@@ -275,9 +275,17 @@ impl PyScene {
         let settings = options.settings(&snap.scene)?;
         let pool = thread_pool(threads)?;
         let (tree, build_s) = octree_for(slf, &snap, settings.use_octree, &pool)?;
+        // Shadow rays ask a light buffer first, as `glint render`'s do;
+        // a counted render walks (the buffer would hide the tree's work).
+        let light_buffer = (!stats && settings.shadows && settings.use_octree)
+            .then(|| pool.install(|| snap.scene.build_light_buffer()))
+            .flatten();
         let renderer = Renderer::with_camera(&snap.scene, &tree, settings, &snap.scene.camera)
-            .map_err(|e| render_error(&e))?;
-        glint::render::memory::check_memory(&settings, tree.stats().memory_bytes)
+            .map_err(|e| render_error(&e))?
+            .with_light_buffer(light_buffer.as_ref());
+        let accel_bytes =
+            tree.stats().memory_bytes + light_buffer.as_ref().map_or(0, |b| b.stats().memory_bytes);
+        glint::render::memory::check_memory(&settings, accel_bytes)
             .map_err(|e| render_error(&e))?;
         let stop = AtomicBool::new(false);
         let pass_options = PassOptions {

@@ -299,6 +299,27 @@ pub fn occlusion_brute_force<C: Counter>(
     }
 }
 
+/// [`occlusion_brute_force`] over only the shapes in `lists`: brute
+/// force's answer when no other shape can meet the ray (a light buffer's
+/// cell and the unbounded shapes).
+pub fn occlusion_among<C: Counter>(
+    prims: &Primitives,
+    lists: [&[u32]; 2],
+    ray: &PreparedRay,
+    t_max: f64,
+    found: &mut ShadowCrossings,
+    counter: &mut C,
+) {
+    found.clear();
+    for list in lists {
+        for &i in list {
+            if test_occlusion(prims, i, ray, t_max, found, counter) {
+                return;
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -4,8 +4,8 @@
 //! force) the integrator asks.
 
 use crate::accel::{
-    Bvh, BvhStack, ClosestHit, Octree, Primitives, ShadowCrossings, WalkLog, WalkStack,
-    closest_brute_force, occlusion_brute_force,
+    Bvh, BvhStack, Candidates, ClosestHit, LightBuffer, Octree, Primitives, ShadowCrossings,
+    WalkLog, WalkStack, closest_brute_force, occlusion_among, occlusion_brute_force,
 };
 use crate::camera::{Camera, CameraError, CameraSpec, sample_offsets};
 use crate::limits::LimitError;
@@ -234,6 +234,9 @@ pub struct Renderer<'a> {
     /// query costs about what the hint does (1 % more instructions per
     /// ray on the two- to six-shape scenes).
     shadow_hints: bool,
+    /// Per light, the shapes that can block each direction of its shadow
+    /// rays ([`Renderer::with_light_buffer`]); uncounted queries only.
+    light_buffer: Option<&'a LightBuffer>,
     pub(super) settings: RenderSettings,
     pub(super) camera: Camera,
     /// What `camera` was made from (a thumbnail of the same view needs it).
@@ -333,6 +336,7 @@ impl<'a> Renderer<'a> {
             bvh: None,
             routes: Routes::new(&settings, octree, false),
             shadow_hints: scene.shapes.len() > HINTS_MIN_SHAPES,
+            light_buffer: None,
             settings,
             camera,
             camera_spec,
@@ -395,6 +399,25 @@ impl<'a> Renderer<'a> {
         self.bvh = Some(bvh);
         self.routes = Routes::new(&self.settings, self.octree, true);
         self
+    }
+
+    /// The light buffer (built over this scene's shapes and lights) that
+    /// shadow rays ask first which shapes they can meet; a buffer of other
+    /// lights or another number of shapes is ignored, and so is any
+    /// buffer when shadows are off or queries go brute force (it would
+    /// hide what the octree buys). The bytes are the same either way;
+    /// counted queries never use it, so Havran's counts stay the
+    /// accelerator's.
+    pub fn with_light_buffer(mut self, buffer: Option<&'a LightBuffer>) -> Self {
+        let lights: Vec<_> = self.scene.lights.iter().map(|l| l.position).collect();
+        let useful = self.settings.shadows && self.settings.accel() != Accel::BruteForce;
+        self.light_buffer = buffer.filter(|b| useful && b.fits(self.scene.shapes.len(), &lights));
+        self
+    }
+
+    /// Whether shadow rays ask a light buffer first.
+    pub fn has_light_buffer(&self) -> bool {
+        self.light_buffer.is_some()
     }
 
     /// Where queries counted by `C` go.
@@ -485,7 +508,10 @@ impl<'a> Renderer<'a> {
     /// Uncounted, the shape that last blocked a shadow ray towards the same
     /// `light` is tested first: if it blocks this one too, no light passes,
     /// whatever else the ray meets, so the answer is the query's. Counted
-    /// queries walk, so Havran's counts stay the accelerator's.
+    /// queries walk, so Havran's counts stay the accelerator's. Then, with
+    /// a light buffer, a ray whose direction lists few shapes tests those
+    /// and the unbounded ones: every shape it can meet, so the answer is
+    /// brute force's.
     pub(super) fn transmittance<C: Counter>(
         &self,
         ray: &PreparedRay,
@@ -516,7 +542,16 @@ impl<'a> Renderer<'a> {
             hint = Some((h, tested));
         }
         let route = self.route::<C>();
-        if route == Route::Bvh
+        let few = match self.light_buffer {
+            Some(buffer) if !C::COUNTS => match buffer.candidates(light, ray.ray.dir) {
+                Candidates::Few(list) => Some([buffer.unbounded(), list]),
+                Candidates::Many => None,
+            },
+            _ => None,
+        };
+        if let Some(lists) = few {
+            occlusion_among(&prims, lists, ray, distance, crossings, query.counter);
+        } else if route == Route::Bvh
             && let Some(tree) = self.bvh
         {
             match self.single_rays.avx2() {
@@ -613,132 +648,4 @@ impl<'a> Renderer<'a> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::accel::sphere_grid;
-    use crate::math::{DVec3, Ray};
-    use crate::scene::ImageSettings;
-    use crate::stats::WorkCounts;
-
-    fn scene_of(shapes: Vec<crate::shapes::Shape>) -> Scene {
-        let camera = CameraSpec {
-            eye: DVec3::new(0.0, 0.0, 10.0),
-            lookat: DVec3::ZERO,
-            up: DVec3::Y,
-            fov: 30.0,
-        };
-        let mut scene = Scene::empty("routes".into(), camera, ImageSettings::default());
-        scene.materials = vec![Material::default()];
-        for shape in shapes {
-            scene.push(shape, 0);
-        }
-        scene
-    }
-
-    fn routes(renderer: &Renderer) -> (Route, Route, bool, bool) {
-        (
-            renderer.route::<WorkCounts>(),
-            renderer.route::<NoCounts>(),
-            renderer.packets_through_octree::<WorkCounts>(),
-            renderer.packets_through_octree::<NoCounts>(),
-        )
-    }
-
-    /// Shadow rays in runs that share an origin and nearly a direction,
-    /// some ending before what blocks their neighbours, through a grid of
-    /// opaque and glass spheres: with the hints carried from ray to ray,
-    /// each lets through exactly what brute force finds.
-    #[test]
-    fn shadow_hints_change_no_answer() {
-        let mut scene = scene_of(sphere_grid(3, 0.45));
-        let glass = Material {
-            transparency: 0.5,
-            ..Material::default()
-        };
-        scene.materials.push(glass);
-        let materials: Vec<u32> = (0..27).map(|i| (i % 5 == 0) as u32).collect();
-        scene.shape_materials = std::sync::Arc::new(materials);
-        let octree = scene.build_octree().unwrap();
-        let renderer = Renderer::new(&scene, &octree, scene.render_settings()).unwrap();
-        assert!(renderer.shadow_hints);
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut uniform = move || {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let mut scratch = Scratch::default();
-        let (mut blocked, mut answered_by_hint) = (0, 0);
-        for run in 0..60 {
-            let origin = DVec3::new(uniform(), uniform(), uniform()) * 8.0 - 3.0;
-            let aim = DVec3::new(uniform(), uniform(), uniform()) * 2.0;
-            let light = run % 3;
-            for _ in 0..40 {
-                let jitter = DVec3::new(uniform(), uniform(), uniform()) - 0.5;
-                let dir = (aim + 0.2 * jitter - origin).normalize();
-                let distance = 0.5 + 9.0 * uniform();
-                let ray = PreparedRay::new(Ray::new(origin, dir));
-                let before = scratch.hints[light];
-                let mut query = Query {
-                    counter: &mut NoCounts,
-                    scratch: &mut scratch,
-                };
-                let pass = renderer.transmittance(&ray, distance, light, &mut query);
-                let mut crossings = ShadowCrossings::default();
-                occlusion_brute_force(
-                    &renderer.primitives(),
-                    &ray,
-                    distance,
-                    &mut crossings,
-                    &mut NoCounts,
-                );
-                let expected = renderer.pass_through(&crossings);
-                assert_eq!(
-                    pass.to_bits(),
-                    expected.to_bits(),
-                    "run {run}: {ray:?} to {distance}"
-                );
-                blocked += (pass == 0.0) as u32;
-                let hint = scratch.hints[light];
-                answered_by_hint +=
-                    (pass == 0.0 && before.score >= 0 && hint.score > before.score) as u32;
-            }
-        }
-        // The hints answered some rays, and not every blocked one.
-        assert!(
-            answered_by_hint > 100 && answered_by_hint < blocked,
-            "{answered_by_hint} of {blocked}"
-        );
-    }
-
-    #[test]
-    fn a_one_leaf_tree_sends_only_counted_queries_through_the_octree() {
-        use Route::*;
-        let few = scene_of(sphere_grid(1, 0.5));
-        let many = scene_of(sphere_grid(4, 0.3));
-        for (scene, uncounted) in [(&few, BruteForce), (&many, Octree)] {
-            let octree = scene.build_octree().unwrap();
-            assert_eq!(octree.is_one_leaf(), uncounted == BruteForce);
-            let bvh = crate::accel::Bvh::build(&scene.shapes);
-            let mut settings = scene.render_settings();
-            let renderer = Renderer::new(scene, &octree, settings).unwrap();
-            let packets = uncounted == Octree;
-            assert_eq!(routes(&renderer), (Octree, uncounted, true, packets));
-            // A BVH takes every query, counted or not, and no packets;
-            // asked for but not given, the settings' octree switch decides.
-            settings.set_accel(Accel::Bvh);
-            let without = Renderer::new(scene, &octree, settings).unwrap();
-            assert_eq!(routes(&without), (BruteForce, BruteForce, false, false));
-            let with = Renderer::new(scene, &octree, settings)
-                .unwrap()
-                .with_bvh(&bvh);
-            assert_eq!(routes(&with), (Bvh, Bvh, false, false));
-            settings.set_accel(Accel::BruteForce);
-            let brute = Renderer::new(scene, &octree, settings)
-                .unwrap()
-                .with_bvh(&bvh);
-            assert_eq!(routes(&brute), (BruteForce, BruteForce, false, false));
-        }
-    }
-}
+mod tests;

@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::accel::{Bvh, BvhStats, OctreeError, OctreeParams, OctreeStats};
+use crate::accel::{Bvh, BvhStats, LightBufferStats, OctreeError, OctreeParams, OctreeStats};
 use crate::render::{Prediction, RenderError, Renderer, UnitCosts, sample_rays};
 use crate::scene::Scene;
 use crate::settings::{Accel, Protocol, RenderSettings};
@@ -56,6 +56,12 @@ pub struct SceneBench {
     /// With `--accel bvh`: the same render through a BVH.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub bvh: Option<BvhBench>,
+    /// The light buffer that `octree_on`'s and `bvh`'s shadow rays asked
+    /// first (shadows on; not for brute force, nor the counted passes):
+    /// its build (median of the repeats, not in `build_s`) and what it
+    /// holds.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub light_buffer: Option<LightBufferBench>,
     /// Brute force time over octree time, measured on the same rays.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub speedup: Option<f64>,
@@ -74,6 +80,14 @@ pub struct SceneBench {
     /// 512x512 under `--protocol spd` only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub published: Option<SpdCounts>,
+}
+
+/// A light buffer's build (median of the repeats) and what it holds.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct LightBufferBench {
+    pub build_s: f64,
+    #[serde(flatten)]
+    pub stats: LightBufferStats,
 }
 
 /// How a scene is benchmarked, besides its render settings.
@@ -206,11 +220,24 @@ pub fn bench_scene(
             bvh = Some(tree);
         }
     }
-    let renderer_on = Renderer::new(scene, &octree, on)?;
+    let mut light_buffer_times = Vec::new();
+    let mut light_buffer = None;
+    if settings.shadows {
+        for _ in 0..options.repeat {
+            check()?;
+            let (buffer, s) = timed(|| pool.install(|| scene.build_light_buffer()));
+            light_buffer_times.push(s);
+            light_buffer = buffer;
+        }
+    }
+    let renderer_on = Renderer::new(scene, &octree, on)?.with_light_buffer(light_buffer.as_ref());
     let renderer_off = Renderer::new(scene, &octree, off)?;
     let renderer_bvh = bvh
         .as_ref()
-        .map(|b| Renderer::new(scene, &octree, through(Accel::Bvh)).map(|r| r.with_bvh(b)))
+        .map(|b| {
+            Renderer::new(scene, &octree, through(Accel::Bvh))
+                .map(|r| r.with_bvh(b).with_light_buffer(light_buffer.as_ref()))
+        })
         .transpose()?;
     check()?;
     let counted_bvh = renderer_bvh
@@ -340,6 +367,10 @@ pub fn bench_scene(
                 bvh_stats: b.stats(),
                 timing: timing(c, median(full_bvh.clone()), c.rays.total() as f64, false),
             }),
+        light_buffer: light_buffer.as_ref().map(|b| LightBufferBench {
+            build_s: median(light_buffer_times.clone()),
+            stats: b.stats(),
+        }),
         speedup,
         compared_rows_every: every,
         counting_overhead: median(counted_times) / on_s,

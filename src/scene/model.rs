@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use crate::accel::{Octree, OctreeError, OctreeParams};
+use crate::accel::{LightBuffer, Octree, OctreeError, OctreeParams};
 use crate::camera::CameraSpec;
 use crate::color::ColorConvention;
 use crate::material::{Light, Material};
@@ -135,6 +135,14 @@ impl Scene {
     /// that vary the parameters build with [`Octree::build`]).
     pub fn build_octree(&self) -> Result<Octree, OctreeError> {
         Octree::build(&self.shapes, self.octree_params)
+    }
+
+    /// The light buffer of this scene's lights over its shapes, for
+    /// [`crate::render::Renderer::with_light_buffer`]; `None` without
+    /// lights or for a scene too large to project quickly.
+    pub fn build_light_buffer(&self) -> Option<LightBuffer> {
+        let lights: Vec<_> = self.lights.iter().map(|l| l.position).collect();
+        LightBuffer::build(&self.shapes, &lights)
     }
 
     /// The settings the scene file asks for: its image size, samples,

@@ -365,6 +365,7 @@ fn run(shared: Arc<Shared>, rx: Receiver<(u64, Job)>, threads: usize) {
             return;
         }
     };
+    let mut light_buffers = LightBufferCache::default();
     while let Ok(mut next) = rx.recv() {
         // Only the newest job matters.
         let dropped = |job: &Job| {
@@ -383,7 +384,7 @@ fn run(shared: Arc<Shared>, rx: Receiver<(u64, Job)>, threads: usize) {
                 break;
             }
             let started = shared.previews_started.load(Ordering::SeqCst);
-            pool.install(|| render_job(&shared, generation, &job));
+            pool.install(|| render_job(&shared, generation, &job, &mut light_buffers));
             if job.preview.is_some() && shared.previews_started.load(Ordering::SeqCst) == started {
                 // Cancelled before it began (or shown from the cache).
                 dropped(&job);
@@ -413,7 +414,33 @@ fn run(shared: Arc<Shared>, rx: Receiver<(u64, Job)>, threads: usize) {
     }
 }
 
-fn render_job(shared: &Shared, generation: u64, job: &Job) {
+/// The light buffer of the newest scene's shapes and lights, kept from
+/// job to job: a new camera reuses it; moving a light or loading another
+/// scene builds it again, before that job's first tile.
+#[derive(Default)]
+struct LightBufferCache {
+    /// The geometry it was built over (a scene's clone shares it).
+    shapes: Option<Arc<Vec<crate::shapes::Shape>>>,
+    buffer: Option<crate::accel::LightBuffer>,
+}
+
+impl LightBufferCache {
+    fn get(&mut self, scene: &crate::scene::Scene) -> Option<&crate::accel::LightBuffer> {
+        let lights: Vec<_> = scene.lights.iter().map(|l| l.position).collect();
+        let same_shapes = self
+            .shapes
+            .as_ref()
+            .is_some_and(|s| Arc::ptr_eq(s, &scene.shapes));
+        let fits = |b: &crate::accel::LightBuffer| b.fits(scene.shapes.len(), &lights);
+        if !same_shapes || !self.buffer.as_ref().is_some_and(fits) {
+            self.buffer = scene.build_light_buffer();
+            self.shapes = Some(Arc::clone(&scene.shapes));
+        }
+        self.buffer.as_ref()
+    }
+}
+
+fn render_job(shared: &Shared, generation: u64, job: &Job, light_buffers: &mut LightBufferCache) {
     let mut settings = job.settings;
     if let Some(p) = job.preview {
         settings.set_anti_aliasing(crate::settings::AntiAliasing::Off);
@@ -426,11 +453,15 @@ fn render_job(shared: &Shared, generation: u64, job: &Job) {
         }
         settings.shadows = p.shadows;
     }
+    let light_buffer = (settings.shadows && settings.accel() != crate::settings::Accel::BruteForce)
+        .then(|| light_buffers.get(&job.scene))
+        .flatten();
     let renderer = match Renderer::with_camera(&job.scene, &job.octree, settings, &job.camera) {
         Ok(r) => match &job.bvh {
             Some(bvh) => r.with_bvh(bvh),
             None => r,
-        },
+        }
+        .with_light_buffer(light_buffer),
         Err(e) => {
             shared.fail(format!("cannot render: {e}"));
             return;

@@ -46,9 +46,11 @@ fn octree_on_and_off_and_the_bvh_give_identical_bytes_for_every_scene() {
         let mut settings = scene.render_settings();
         (settings.width, settings.height, settings.samples) = (side, side, 1);
         settings.set_accel(glint::settings::Accel::Bvh);
+        let light_buffer = scene.build_light_buffer();
         let renderer = Renderer::new(scene, octree, settings)
             .unwrap()
-            .with_bvh(&bvh);
+            .with_bvh(&bvh)
+            .with_light_buffer(light_buffer.as_ref());
         // Uncounted: single rays through the BVH's wide walk; counted:
         // through its binary walk.
         let (frame, _) = renderer.render(false, None);

@@ -338,12 +338,16 @@ fn sweep(args: &BenchArgs) -> Result<()> {
         let mut settings = bench_settings(args, &mut scene);
         settings.use_octree = true;
         say!("sweep {}", path.display());
+        // Every setting's shadow rays ask the same light buffer first, as
+        // a render's do: the sweep varies only the tree.
+        let light_buffer = pool.install(|| scene.build_light_buffer());
         // Unit costs once per scene, on its own octree setting, and how
         // the time per ray changes with the image's size (the scene's and
         // view's, as "Suggest a setting" takes it).
         let (unit_costs, per_doubling) = {
             let octree = pool.install(|| scene.build_octree())?;
-            let renderer = Renderer::new(&scene, &octree, settings)?;
+            let renderer =
+                Renderer::new(&scene, &octree, settings)?.with_light_buffer(light_buffer.as_ref());
             let sample = glint::render::sample_rays(&renderer, &octree)?;
             (
                 UnitCosts::measure(&renderer, &octree)?,
@@ -405,7 +409,8 @@ fn sweep(args: &BenchArgs) -> Result<()> {
             // The prediction comes first: it needs the tree, not the render
             // (the ray count, which the octree does not change, excepted).
             let predicted_cost = octree.predicted_cost();
-            let renderer = Renderer::new(&scene, &octree, settings)?;
+            let renderer =
+                Renderer::new(&scene, &octree, settings)?.with_light_buffer(light_buffer.as_ref());
             let ray_sample = glint::render::sample_rays_with(&renderer, &octree, per_doubling)?;
             let counts = pool.install(|| renderer.render(true, None).1);
             for _ in 0..args.repeat {

@@ -118,6 +118,9 @@ struct Prepared {
     octree: Octree,
     /// Built with `--accel bvh`: then it answers every query.
     bvh: Option<glint::accel::Bvh>,
+    /// Built when shadow rays go through an accelerator (it answers
+    /// theirs first), with the seconds it took.
+    light_buffer: Option<(glint::accel::LightBuffer, f64)>,
     overlay_depth: Option<u32>,
     legend: bool,
     threads: usize,
@@ -132,7 +135,8 @@ impl Prepared {
         &self,
         settings: RenderSettings,
     ) -> Result<Renderer<'_>, glint::render::RenderError> {
-        let renderer = Renderer::with_camera(&self.scene, &self.octree, settings, &self.camera)?;
+        let renderer = Renderer::with_camera(&self.scene, &self.octree, settings, &self.camera)?
+            .with_light_buffer(self.light_buffer.as_ref().map(|(b, _)| b));
         Ok(match &self.bvh {
             Some(bvh) => renderer.with_bvh(bvh),
             None => renderer,
@@ -240,12 +244,24 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
     };
     let bvh = (settings.accel() == Accel::Bvh).then(|| pool.install(|| Bvh::build(&scene.shapes)));
     let build_s = build_start.elapsed().as_secs_f64();
+    // `--stats` renders counting the accelerator's work, which the
+    // buffer would hide: there it is not built.
+    let light_buffer = (settings.shadows && settings.accel() != Accel::BruteForce && !args.stats)
+        .then(|| {
+            let start = Instant::now();
+            let built = pool.install(|| scene.build_light_buffer())?;
+            Some((built, start.elapsed().as_secs_f64()))
+        })
+        .flatten();
     if args.output.is_some() {
         // Validate before starting.
         Renderer::with_camera(&scene, &octree, settings, &camera)
             .with_context(|| format!("cannot render {scene_name}"))?;
-        let accel_bytes =
-            octree.stats().memory_bytes + bvh.as_ref().map_or(0, |b| b.stats().memory_bytes);
+        let accel_bytes = octree.stats().memory_bytes
+            + bvh.as_ref().map_or(0, |b| b.stats().memory_bytes)
+            + light_buffer
+                .as_ref()
+                .map_or(0, |(b, _)| b.stats().memory_bytes);
         glint::render::memory::check_memory(&settings, accel_bytes)
             .with_context(|| format!("cannot render {scene_name}"))?;
     }
@@ -256,6 +272,7 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
         camera,
         octree,
         bvh,
+        light_buffer,
         overlay_depth,
         legend,
         threads,
@@ -375,8 +392,14 @@ fn report(
             }
             _ => String::new(),
         };
+        let light_buffer_s = job.light_buffer.as_ref().map_or(0.0, |(_, s)| *s);
+        let light_buffer_note = if job.light_buffer.is_some() {
+            format!("; light buffer {light_buffer_s:.3} s")
+        } else {
+            String::new()
+        };
         say!(
-            "wrote {} ({}x{}{written}) in {:.2} s: load {:.2} s, {} build {:.2} s, render {:.2} s, write {:.2} s",
+            "wrote {} ({}x{}{written}) in {:.2} s: load {:.2} s, {} build {:.2} s, render {:.2} s, write {:.2} s{light_buffer_note}",
             if output.as_os_str() == "-" {
                 "standard output".to_string()
             } else {
@@ -384,7 +407,7 @@ fn report(
             },
             width,
             height,
-            job.load_s + job.build_s + render_s + write_s,
+            job.load_s + job.build_s + light_buffer_s + render_s + write_s,
             job.load_s,
             if job.bvh.is_some() { "BVH" } else { "octree" },
             job.build_s,
@@ -432,6 +455,7 @@ fn report(
         Some(bvh) => stats.with_bvh(bvh.stats()),
         None => stats,
     };
+
     out!("{}", serde_json::to_string_pretty(&stats)?)?;
     Ok(())
 }

@@ -44,6 +44,8 @@ pub struct StudyArgs {
 struct Study<'a> {
     scene: &'a Scene,
     octree: Octree,
+    /// Asked first by every timed render's shadow rays, as in a release render.
+    light_buffer: Option<glint::accel::LightBuffer>,
 
     repeat: u32,
     pool: rayon::ThreadPool,
@@ -67,7 +69,8 @@ impl Study<'_> {
         repeat: u32,
     ) -> Result<(f64, Frame)> {
         let octree = octree.unwrap_or(&self.octree);
-        let renderer = Renderer::new(self.scene, octree, settings)?;
+        let renderer = Renderer::new(self.scene, octree, settings)?
+            .with_light_buffer(self.light_buffer.as_ref());
         let mut times = Vec::new();
         let mut frame = None;
         for _ in 0..repeat.max(1) {
@@ -144,6 +147,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
         base.use_octree = true;
         let study = Study {
             octree: scene.build_octree()?,
+            light_buffer: scene.build_light_buffer(),
             scene: &scene,
             repeat: args.repeat,
             pool: thread_pool(args.threads)?,

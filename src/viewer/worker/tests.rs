@@ -94,3 +94,46 @@ fn the_history_keeps_full_passes_and_the_newest_previews() {
     assert_eq!(oldest_preview, Some(6));
     assert_eq!(held.map(|h| h.len()), Some(6));
 }
+
+#[test]
+fn the_light_buffer_follows_moved_lights_and_new_geometry() {
+    use crate::math::DVec3;
+    let camera = crate::camera::CameraSpec {
+        eye: DVec3::new(0.0, 0.0, 5.0),
+        lookat: DVec3::ZERO,
+        up: DVec3::Y,
+        fov: 40.0,
+    };
+    let image = crate::scene::ImageSettings::default();
+    let mut scene = crate::scene::Scene::empty("cache".into(), camera, image);
+    scene.materials = vec![crate::material::Material::default()];
+    let sphere = crate::shapes::Sphere::new(DVec3::ZERO, 1.0);
+    scene.push(crate::shapes::Shape::Sphere(sphere), 0);
+    scene.lights = vec![crate::material::Light {
+        position: DVec3::new(2.0, 3.0, 4.0),
+        color: DVec3::ONE,
+    }];
+    let mut cache = LightBufferCache::default();
+    let fits = |c: &mut LightBufferCache, s: &crate::scene::Scene| {
+        let lights: Vec<_> = s.lights.iter().map(|l| l.position).collect();
+        c.get(s).is_some_and(|b| b.fits(s.shapes.len(), &lights))
+    };
+    let address = |c: &LightBufferCache| c.buffer.as_ref().map(|b| b as *const _);
+    assert!(fits(&mut cache, &scene));
+    let first = address(&cache);
+    // A new camera keeps it; a moved light builds it again.
+    assert!(fits(&mut cache, &scene));
+    assert_eq!(address(&cache), first);
+    scene.lights[0].position.x += 1.0;
+    assert!(fits(&mut cache, &scene));
+    // Other geometry of the same size builds it again too.
+    let mut other = scene.clone();
+    other.shapes = Arc::new(other.shapes.as_ref().clone());
+    assert!(fits(&mut cache, &other));
+    assert!(
+        cache
+            .shapes
+            .as_ref()
+            .is_some_and(|s| Arc::ptr_eq(s, &other.shapes))
+    );
+}

@@ -107,7 +107,12 @@ pub fn render_with(
     settings.width = width;
     settings.height = height;
     adjust(&mut settings);
-    let renderer = Renderer::new(scene, octree, settings).unwrap();
+    // With the light buffer a release render has (it answers only where
+    // an accelerator would, so octree-off renders stay brute force).
+    let light_buffer = scene.build_light_buffer();
+    let renderer = Renderer::new(scene, octree, settings)
+        .unwrap()
+        .with_light_buffer(light_buffer.as_ref());
     let (frame, counts) = renderer.render(false, None);
     (frame.to_rgb8(), counts)
 }

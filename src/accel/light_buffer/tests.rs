@@ -1,0 +1,290 @@
+//! The light buffer against brute force on scenes made to break it.
+
+use super::*;
+use crate::accel::{Primitives, ShadowCrossings, occlusion_among, occlusion_brute_force};
+use crate::math::Ray;
+use crate::shapes::{Plane, PreparedRay, Sphere, Triangle};
+use crate::stats::NoCounts;
+
+/// A deterministic stream of numbers in `[0, 1)`.
+struct Uniform(u64);
+
+impl Uniform {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    fn point(&mut self, b: Aabb) -> DVec3 {
+        let t = DVec3::new(self.next(), self.next(), self.next());
+        b.min + t * b.extent()
+    }
+}
+
+/// How a scene's shadow rays went.
+#[derive(Debug, Default)]
+struct Tally {
+    /// Answered from a cell's list, of which the list was not empty.
+    few: usize,
+    listed: usize,
+    many: usize,
+    blocked: usize,
+}
+
+/// Shadow rays from points over `shapes`' boxes (and on their surfaces,
+/// by aiming at them) to each light, answered through the buffer where it
+/// lists a cell and checked bit for bit against brute force.
+fn check(shapes: &[Shape], lights: &[DVec3], transparent: &[bool], rays: usize) -> Tally {
+    let buffer = LightBuffer::build(shapes, lights).expect("a small scene keeps a buffer");
+    assert!(buffer.fits(shapes.len(), lights));
+    let prims = Primitives {
+        shapes,
+        one_sided: &[],
+        transparent,
+    };
+    let bounds = shapes
+        .iter()
+        .filter_map(Shape::bounds)
+        .fold(Aabb::from_points(lights), Aabb::union);
+    // Origins a little outside the scene too.
+    let around = Aabb::new(
+        bounds.min - 0.1 * bounds.extent(),
+        bounds.max + 0.1 * bounds.extent(),
+    );
+    let mut uniform = Uniform(0x9e37_79b9_7f4a_7c15);
+    let mut tally = Tally::default();
+    for n in 0..rays {
+        let light_index = n % lights.len();
+        let light = lights[light_index];
+        let mut origin = uniform.point(around);
+        // Every third ray starts on the first surface seen from a random
+        // point towards the light, as a renderer's shadow rays do.
+        if n % 3 == 0 {
+            let ray = PreparedRay::new(Ray::new(origin, (light - origin).normalize()));
+            let hit = crate::accel::closest_brute_force(&prims, &ray, f64::INFINITY, &mut NoCounts);
+            if let Some(hit) = hit {
+                origin = ray.ray.at(hit.hit.t);
+            }
+        }
+        let to_light = light - origin;
+        let distance = to_light.length();
+        if !(distance > 0.0) {
+            continue;
+        }
+        let ray = PreparedRay::new(Ray::new(origin, to_light / distance));
+        let mut expected = ShadowCrossings::default();
+        occlusion_brute_force(&prims, &ray, distance, &mut expected, &mut NoCounts);
+        tally.blocked += expected.is_blocked() as usize;
+        match buffer.candidates(light_index, ray.ray.dir) {
+            Candidates::Few(list) => {
+                tally.few += 1;
+                tally.listed += !list.is_empty() as usize;
+                let mut found = ShadowCrossings::default();
+                let lists = [buffer.unbounded(), list];
+                occlusion_among(&prims, lists, &ray, distance, &mut found, &mut NoCounts);
+                assert_eq!(
+                    found.is_blocked(),
+                    expected.is_blocked(),
+                    "ray {n} from {origin:?} to light {light:?}: listed {list:?}"
+                );
+                if !expected.is_blocked() {
+                    assert_eq!(found, expected, "ray {n} from {origin:?} to {light:?}");
+                }
+            }
+            Candidates::Many => tally.many += 1,
+        }
+    }
+    tally
+}
+
+fn sphere(c: DVec3, r: f64) -> Shape {
+    Shape::Sphere(Sphere::new(c, r))
+}
+
+fn triangle(a: DVec3, b: DVec3, c: DVec3) -> Shape {
+    Shape::Triangle(Triangle::new([a, b, c]).expect("not degenerate"))
+}
+
+/// Spheres on a grid with lights among them, thin triangles across the
+/// planes through each light, a triangle through a light, a sphere whose
+/// surface holds a light, and a floor.
+fn adversarial(scale: f64, offset: DVec3) -> (Vec<Shape>, Vec<DVec3>) {
+    let p = |x: f64, y: f64, z: f64| offset + scale * DVec3::new(x, y, z);
+    let mut shapes = crate::accel::sphere_grid(4, 0.3)
+        .into_iter()
+        .map(|s| match s {
+            Shape::Sphere(s) => sphere(offset + scale * s.center, scale * s.radius),
+            other => other,
+        })
+        .collect::<Vec<_>>();
+    let lights = vec![p(1.5, 1.5, 1.5), p(0.0, 0.0, 5.0), p(3.0, 0.5, 0.5)];
+    // Long slivers straddling x = 1.5, y = 1.5 and z = 1.5.
+    for k in 0..4 {
+        let s = k as f64;
+        shapes.push(triangle(
+            p(-2.0, s, 0.7),
+            p(5.0, s, 0.75),
+            p(5.0, s + 0.01, 0.7),
+        ));
+        shapes.push(triangle(
+            p(0.7, -2.0, s),
+            p(0.75, 5.0, s),
+            p(0.7, 5.0, s + 0.01),
+        ));
+        shapes.push(triangle(
+            p(s, 0.7, -2.0),
+            p(s, 0.75, 5.0),
+            p(s + 0.01, 0.7, 5.0),
+        ));
+    }
+    // The second light lies in this triangle's plane, on its edge.
+    shapes.push(triangle(
+        p(-1.0, 0.0, 5.0),
+        p(1.0, 0.0, 5.0),
+        p(0.0, 1.0, 5.0),
+    ));
+    // The third light lies on this sphere's surface.
+    shapes.push(sphere(p(3.0, 0.5, 0.0), 0.5 * scale));
+    // A tiny sphere next to the first light, inside its near zone's reach
+    // only at the smallest scales.
+    shapes.push(sphere(p(1.5 + 1e-7, 1.5, 1.5), 1e-8 * scale));
+    shapes.push(Shape::Plane(Plane::new(p(0.0, -1.0, 0.0), DVec3::Y)));
+    (shapes, lights)
+}
+
+#[test]
+fn a_buffer_answers_as_brute_force_on_adversarial_scenes() {
+    let cases = [
+        (1.0, DVec3::ZERO),
+        (1e-6, DVec3::ZERO),
+        (1e6, DVec3::ZERO),
+        (1.0, DVec3::new(1e7, -3e6, 2e7)),
+        (1e-3, DVec3::new(5e3, 5e3, -5e3)),
+    ];
+    for (scale, offset) in cases {
+        let (shapes, lights) = adversarial(scale, offset);
+        let transparent: Vec<bool> = (0..shapes.len()).map(|i| i % 4 == 1).collect();
+        for transparent in [&[][..], &transparent[..]] {
+            let tally = check(&shapes, &lights, transparent, 6_000);
+            // The lists answered most rays, many of them with shapes to test.
+            assert!(
+                tally.few > 3_000 && tally.listed > 500 && tally.blocked > 500,
+                "scale {scale}, offset {offset:?}: {tally:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn rays_along_the_cube_edges_and_axes_answer_as_brute_force() {
+    // A light at the centre of a shell of small spheres placed exactly on
+    // the axes and the diagonals, where a direction's face is a tie.
+    let light = DVec3::new(0.25, -0.5, 2.0);
+    let mut shapes = Vec::new();
+    for x in -1..=1 {
+        for y in -1..=1 {
+            for z in -1..=1 {
+                if (x, y, z) != (0, 0, 0) {
+                    let d = DVec3::new(x as f64, y as f64, z as f64);
+                    shapes.push(sphere(light + 2.0 * d, 0.05));
+                }
+            }
+        }
+    }
+    let buffer = LightBuffer::build(&shapes, &[light]).unwrap();
+    let prims = Primitives::opaque(&shapes);
+    let mut blocked = 0;
+    for (i, shape) in shapes.iter().enumerate() {
+        let Shape::Sphere(s) = shape else { continue };
+        // From just beyond each sphere, straight through its centre to the light.
+        let origin = light + 1.5 * (s.center - light);
+        let to_light = light - origin;
+        let distance = to_light.length();
+        let ray = PreparedRay::new(Ray::new(origin, to_light / distance));
+        let Candidates::Few(list) = buffer.candidates(0, ray.ray.dir) else {
+            panic!("ray {i}: a few spheres per cell")
+        };
+        let mut found = ShadowCrossings::default();
+        occlusion_among(
+            &prims,
+            [&[], list],
+            &ray,
+            distance,
+            &mut found,
+            &mut NoCounts,
+        );
+        assert!(found.is_blocked(), "ray {i}: listed {list:?}");
+        blocked += 1;
+    }
+    assert_eq!(blocked, 26);
+}
+
+#[test]
+fn crowded_cells_go_to_the_accelerator() {
+    // Forty spheres in a row seen end on from the light: their cells list
+    // too many, and so do the cells of a light inside all their boxes.
+    let shapes: Vec<Shape> = (0..40)
+        .map(|i| sphere(DVec3::new(2.0 + i as f64, 0.0, 0.0), 0.4))
+        .collect();
+    let beyond = LightBuffer::build(&shapes, &[DVec3::ZERO]).unwrap();
+    assert!(matches!(
+        beyond.candidates(0, DVec3::NEG_X),
+        Candidates::Many
+    ));
+    assert!(matches!(
+        beyond.candidates(0, DVec3::X),
+        Candidates::Few([])
+    ));
+    let mut big = shapes.clone();
+    big.extend((0..8).map(|_| sphere(DVec3::ZERO, 100.0)));
+    let inside = LightBuffer::build(&big, &[DVec3::ZERO]).unwrap();
+    assert_eq!(inside.stats().cubes, 0, "every cell long: no cube");
+    assert!(matches!(inside.candidates(0, DVec3::X), Candidates::Many));
+}
+
+#[test]
+fn a_buffer_fits_only_its_own_lights_and_shapes() {
+    let shapes = vec![sphere(DVec3::ZERO, 1.0)];
+    let lights = [DVec3::new(0.0, 5.0, 0.0)];
+    let buffer = LightBuffer::build(&shapes, &lights).unwrap();
+    assert!(buffer.fits(1, &lights));
+    assert!(!buffer.fits(2, &lights));
+    assert!(!buffer.fits(1, &[DVec3::new(0.0, 5.0, 1e-12)]));
+    assert!(LightBuffer::build(&shapes, &[]).is_none());
+    // A light with no cube answers "ask the accelerator".
+    assert!(matches!(buffer.candidates(7, DVec3::X), Candidates::Many));
+}
+
+#[test]
+fn counts_by_difference_table_match_counting_cell_by_cell() {
+    let mut uniform = Uniform(7);
+    let rects: Vec<Rect> = (0..200)
+        .map(|k| {
+            let mut c = [0u8; 4];
+            for pair in 0..2 {
+                let a = (uniform.next() * SIDE as f64) as u8;
+                let b = (uniform.next() * SIDE as f64) as u8;
+                c[2 * pair] = a.min(b);
+                c[2 * pair + 1] = a.max(b);
+            }
+            Rect {
+                shape: k,
+                face: (k % 6) as u8,
+                cells: c,
+            }
+        })
+        .collect();
+    let mut direct = vec![0u32; CUBE_CELLS];
+    for r in &rects {
+        let [i0, i1, j0, j1] = r.cells.map(usize::from);
+        for j in j0..=j1 {
+            for i in i0..=i1 {
+                direct[r.face as usize * FACE_CELLS + j * SIDE + i] += 1;
+            }
+        }
+    }
+    assert_eq!(cell_counts(&rects), direct);
+}

@@ -1,0 +1,200 @@
+//! The renderer's routes, shadow hints and light buffer against brute force.
+
+use super::*;
+use crate::accel::sphere_grid;
+use crate::math::{DVec3, Ray};
+use crate::scene::ImageSettings;
+use crate::stats::WorkCounts;
+
+fn scene_of(shapes: Vec<crate::shapes::Shape>) -> Scene {
+    let camera = CameraSpec {
+        eye: DVec3::new(0.0, 0.0, 10.0),
+        lookat: DVec3::ZERO,
+        up: DVec3::Y,
+        fov: 30.0,
+    };
+    let mut scene = Scene::empty("routes".into(), camera, ImageSettings::default());
+    scene.materials = vec![Material::default()];
+    for shape in shapes {
+        scene.push(shape, 0);
+    }
+    scene
+}
+
+fn routes(renderer: &Renderer) -> (Route, Route, bool, bool) {
+    (
+        renderer.route::<WorkCounts>(),
+        renderer.route::<NoCounts>(),
+        renderer.packets_through_octree::<WorkCounts>(),
+        renderer.packets_through_octree::<NoCounts>(),
+    )
+}
+
+/// Shadow rays in runs that share an origin and nearly a direction,
+/// some ending before what blocks their neighbours, through a grid of
+/// opaque and glass spheres: with the hints carried from ray to ray,
+/// each lets through exactly what brute force finds.
+#[test]
+fn shadow_hints_change_no_answer() {
+    let mut scene = scene_of(sphere_grid(3, 0.45));
+    let glass = Material {
+        transparency: 0.5,
+        ..Material::default()
+    };
+    scene.materials.push(glass);
+    let materials: Vec<u32> = (0..27).map(|i| (i % 5 == 0) as u32).collect();
+    scene.shape_materials = std::sync::Arc::new(materials);
+    let octree = scene.build_octree().unwrap();
+    let renderer = Renderer::new(&scene, &octree, scene.render_settings()).unwrap();
+    assert!(renderer.shadow_hints);
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut uniform = move || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut scratch = Scratch::default();
+    let (mut blocked, mut answered_by_hint) = (0, 0);
+    for run in 0..60 {
+        let origin = DVec3::new(uniform(), uniform(), uniform()) * 8.0 - 3.0;
+        let aim = DVec3::new(uniform(), uniform(), uniform()) * 2.0;
+        let light = run % 3;
+        for _ in 0..40 {
+            let jitter = DVec3::new(uniform(), uniform(), uniform()) - 0.5;
+            let dir = (aim + 0.2 * jitter - origin).normalize();
+            let distance = 0.5 + 9.0 * uniform();
+            let ray = PreparedRay::new(Ray::new(origin, dir));
+            let before = scratch.hints[light];
+            let mut query = Query {
+                counter: &mut NoCounts,
+                scratch: &mut scratch,
+            };
+            let pass = renderer.transmittance(&ray, distance, light, &mut query);
+            let mut crossings = ShadowCrossings::default();
+            occlusion_brute_force(
+                &renderer.primitives(),
+                &ray,
+                distance,
+                &mut crossings,
+                &mut NoCounts,
+            );
+            let expected = renderer.pass_through(&crossings);
+            assert_eq!(
+                pass.to_bits(),
+                expected.to_bits(),
+                "run {run}: {ray:?} to {distance}"
+            );
+            blocked += (pass == 0.0) as u32;
+            let hint = scratch.hints[light];
+            answered_by_hint +=
+                (pass == 0.0 && before.score >= 0 && hint.score > before.score) as u32;
+        }
+    }
+    // The hints answered some rays, and not every blocked one.
+    assert!(
+        answered_by_hint > 100 && answered_by_hint < blocked,
+        "{answered_by_hint} of {blocked}"
+    );
+}
+
+/// Shadow rays from random points to each light of a grid of opaque
+/// and glass spheres with lights among them let through the same with
+/// the light buffer as without; the buffer is ignored where it would
+/// hide the octree's work or answer for moved lights.
+#[test]
+fn the_light_buffer_changes_no_answer() {
+    let mut scene = scene_of(sphere_grid(4, 0.3));
+    scene.materials.push(Material {
+        transparency: 0.5,
+        ..Material::default()
+    });
+    let materials: Vec<u32> = (0..64).map(|i| (i % 3 == 0) as u32).collect();
+    scene.shape_materials = std::sync::Arc::new(materials);
+    let at = |x, y, z| crate::material::Light {
+        position: DVec3::new(x, y, z),
+        color: DVec3::ONE,
+    };
+    scene.lights = vec![at(1.5, 1.5, 1.5), at(-2.0, 5.0, 0.5), at(3.0, 0.5, 0.5)];
+    let octree = scene.build_octree().unwrap();
+    let buffer = scene.build_light_buffer();
+    let plain = Renderer::new(&scene, &octree, scene.render_settings()).unwrap();
+    let buffered = Renderer::new(&scene, &octree, scene.render_settings())
+        .unwrap()
+        .with_light_buffer(buffer.as_ref());
+    assert!(buffered.has_light_buffer() && !plain.has_light_buffer());
+    let mut uniform = 0x853c_49e6_748f_ea9bu64;
+    let mut uniform = move || {
+        uniform = uniform
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1);
+        (uniform >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let (mut scratch, mut plain_scratch) = (Scratch::default(), Scratch::default());
+    let (mut blocked, mut lit) = (0, 0);
+    for n in 0..3_000 {
+        let light = n % 3;
+        let origin = DVec3::new(uniform(), uniform(), uniform()) * 6.0 - 1.5;
+        let to_light = scene.lights[light].position - origin;
+        let ray = PreparedRay::new(Ray::new(origin, to_light.normalize()));
+        let pass = |renderer: &Renderer, scratch: &mut Scratch| {
+            let mut query = Query {
+                counter: &mut NoCounts,
+                scratch,
+            };
+            renderer.transmittance(&ray, to_light.length(), light, &mut query)
+        };
+        let expected = pass(&plain, &mut plain_scratch);
+        assert_eq!(
+            pass(&buffered, &mut scratch).to_bits(),
+            expected.to_bits(),
+            "ray {n}: {ray:?}"
+        );
+        blocked += (expected == 0.0) as u32;
+        lit += (expected == 1.0) as u32;
+    }
+    assert!(blocked > 300 && lit > 300, "{blocked} blocked, {lit} lit");
+    // Brute force stays brute force; a moved light finds no buffer.
+    let mut off = scene.render_settings();
+    off.use_octree = false;
+    let brute = Renderer::new(&scene, &octree, off).unwrap();
+    assert!(!brute.with_light_buffer(buffer.as_ref()).has_light_buffer());
+    let mut moved = scene.clone();
+    moved.lights[2].position.x += 1e-9;
+    let renderer = Renderer::new(&moved, &octree, moved.render_settings()).unwrap();
+    assert!(
+        !renderer
+            .with_light_buffer(buffer.as_ref())
+            .has_light_buffer()
+    );
+}
+
+#[test]
+fn a_one_leaf_tree_sends_only_counted_queries_through_the_octree() {
+    use Route::*;
+    let few = scene_of(sphere_grid(1, 0.5));
+    let many = scene_of(sphere_grid(4, 0.3));
+    for (scene, uncounted) in [(&few, BruteForce), (&many, Octree)] {
+        let octree = scene.build_octree().unwrap();
+        assert_eq!(octree.is_one_leaf(), uncounted == BruteForce);
+        let bvh = crate::accel::Bvh::build(&scene.shapes);
+        let mut settings = scene.render_settings();
+        let renderer = Renderer::new(scene, &octree, settings).unwrap();
+        let packets = uncounted == Octree;
+        assert_eq!(routes(&renderer), (Octree, uncounted, true, packets));
+        // A BVH takes every query, counted or not, and no packets;
+        // asked for but not given, the settings' octree switch decides.
+        settings.set_accel(Accel::Bvh);
+        let without = Renderer::new(scene, &octree, settings).unwrap();
+        assert_eq!(routes(&without), (BruteForce, BruteForce, false, false));
+        let with = Renderer::new(scene, &octree, settings)
+            .unwrap()
+            .with_bvh(&bvh);
+        assert_eq!(routes(&with), (Bvh, Bvh, false, false));
+        settings.set_accel(Accel::BruteForce);
+        let brute = Renderer::new(scene, &octree, settings)
+            .unwrap()
+            .with_bvh(&bvh);
+        assert_eq!(routes(&brute), (BruteForce, BruteForce, false, false));
+    }
+}
