@@ -302,6 +302,7 @@ pub fn occlusion_brute_force<C: Counter>(
 /// [`occlusion_brute_force`] over only the shapes in `lists`: brute
 /// force's answer when no other shape can meet the ray (a light buffer's
 /// cell and the unbounded shapes).
+#[inline(always)]
 pub fn occlusion_among<C: Counter>(
     prims: &Primitives,
     lists: [&[u32]; 2],

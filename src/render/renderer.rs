@@ -160,6 +160,32 @@ impl pulp::WithSimd for OcclusionQuery<'_> {
     }
 }
 
+/// A shadow ray's crossings among a light buffer's few shapes (nothing
+/// counted), compiled for the render's SIMD level.
+struct AmongQuery<'q> {
+    prims: &'q Primitives<'q>,
+    lists: [&'q [u32]; 2],
+    ray: &'q PreparedRay,
+    distance: f64,
+    crossings: &'q mut ShadowCrossings,
+}
+
+impl pulp::WithSimd for AmongQuery<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+        occlusion_among(
+            self.prims,
+            self.lists,
+            self.ray,
+            self.distance,
+            self.crossings,
+            &mut NoCounts,
+        );
+    }
+}
+
 /// A single ray's closest hit or shadow crossings through the BVH (nothing
 /// counted), as a function compiled for the render's SIMD level.
 struct BvhQuery<'q> {
@@ -550,7 +576,19 @@ impl<'a> Renderer<'a> {
             _ => None,
         };
         if let Some(lists) = few {
-            occlusion_among(&prims, lists, ray, distance, crossings, query.counter);
+            match self.single_rays.avx2() {
+                Some(simd) => pulp::Simd::vectorize(
+                    simd,
+                    AmongQuery {
+                        prims: &prims,
+                        lists,
+                        ray,
+                        distance,
+                        crossings,
+                    },
+                ),
+                None => occlusion_among(&prims, lists, ray, distance, crossings, query.counter),
+            }
         } else if route == Route::Bvh
             && let Some(tree) = self.bvh
         {

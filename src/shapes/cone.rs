@@ -58,7 +58,7 @@ impl Cone {
     /// that pass far from a thin cone, hits the octree (which only looks
     /// near the cone) would never see. The nearest point, not the
     /// segment's middle: a cone can be far longer than the ray is long.
-    #[inline]
+    #[inline(always)]
     fn roots(&self, ray: &Ray) -> Option<((f64, f64), impl Fn(f64) -> bool)> {
         let (shift, along) = self.nearest_to_axis(ray);
         let o = (ray.origin + shift * ray.dir) - self.base;
@@ -98,7 +98,7 @@ impl Cone {
     /// it, then the line's nearest to that point; 0 if not finite), and
     /// that segment parameter (NaN where the line's is not finite, so
     /// that no gap computed from it rules a hit out).
-    #[inline]
+    #[inline(always)]
     fn nearest_to_axis(&self, ray: &Ray) -> (f64, f64) {
         let w = ray.origin - self.base;
         let (dd, da) = (ray.dir.length_squared(), ray.dir.dot(self.axis));
@@ -119,7 +119,7 @@ impl Cone {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<ShapeHit> {
         let ((t0, t1), on_part) = self.roots(ray)?;
         [t0, t1]
@@ -129,7 +129,7 @@ impl Cone {
     }
 
     /// Every crossing of the surface with `0 < t < t_max` (at most two).
-    #[inline]
+    #[inline(always)]
     pub fn crossings(&self, ray: &Ray, t_max: f64) -> Crossings {
         let mut out = Crossings::default();
         if let Some(((t0, t1), on_part)) = self.roots(ray) {

@@ -56,7 +56,7 @@ pub enum Shape {
 
 impl Shape {
     /// Closest hit with `0 < t < t_max`.
-    #[inline]
+    #[inline(always)]
     pub fn intersect(&self, ray: &PreparedRay, t_max: f64) -> Option<ShapeHit> {
         match self {
             Shape::Sphere(s) => s.intersect(&ray.ray, t_max),
@@ -71,7 +71,7 @@ impl Shape {
     /// a one-sided shape is invisible from behind (the SPD's rule for opaque
     /// primitives). The outside of a triangle is the side from which its
     /// vertices run counter-clockwise; of a quadric, where `F > 0`.
-    #[inline]
+    #[inline(always)]
     pub fn intersect_front(&self, ray: &PreparedRay, t_max: f64) -> Option<ShapeHit> {
         let d = ray.ray.dir;
         let front = |outward: DVec3| d.dot(outward) < 0.0;
@@ -111,7 +111,7 @@ impl Shape {
 
     /// Every crossing of the surface with `0 < t < t_max`, nearest first:
     /// what a shadow ray needs to attenuate light once per surface crossed.
-    #[inline]
+    #[inline(always)]
     pub fn crossings(&self, ray: &PreparedRay, t_max: f64) -> Crossings {
         match self {
             Shape::Sphere(s) => s.crossings(&ray.ray, t_max),

@@ -20,7 +20,7 @@ impl Plane {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<ShapeHit> {
         let denom = ray.dir.dot(self.normal);
         if denom == 0.0 {

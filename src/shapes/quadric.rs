@@ -91,7 +91,7 @@ impl Quadric {
     /// The parameters where the ray's line meets the surface, smaller first,
     /// and the parameter range inside the clip box (`None` if the ray misses
     /// the box before `t_max`).
-    #[inline]
+    #[inline(always)]
     fn roots(&self, ray: &Ray, t_max: f64) -> Option<((f64, f64), (f64, f64))> {
         let mut range = (0.0, t_max);
         if let Some(clip) = &self.clip {
@@ -110,7 +110,7 @@ impl Quadric {
         t > 0.0 && t < t_max && t >= t_lo && t <= t_hi && self.inside_clip(ray.at(t))
     }
 
-    #[inline]
+    #[inline(always)]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<ShapeHit> {
         let ((t0, t1), range) = self.roots(ray, t_max)?;
         [t0, t1]
@@ -120,7 +120,7 @@ impl Quadric {
     }
 
     /// Every crossing of the surface with `0 < t < t_max` (at most two).
-    #[inline]
+    #[inline(always)]
     pub fn crossings(&self, ray: &Ray, t_max: f64) -> Crossings {
         let mut out = Crossings::default();
         if let Some(((t0, t1), range)) = self.roots(ray, t_max) {

@@ -21,7 +21,7 @@ impl Sphere {
     /// Intersection" (Ray Tracing Gems ch. 7): the discriminant is
     /// `r^2 - |f - (f.d) d|^2`, which stays accurate for a small sphere far
     /// away, and the roots use the stable `c / q`, `q` pair.
-    #[inline]
+    #[inline(always)]
     fn roots(&self, ray: &Ray) -> Option<(f64, f64)> {
         let f = ray.origin - self.center;
         let b = f.dot(ray.dir);
@@ -38,7 +38,7 @@ impl Sphere {
     }
 
     /// The nearest hit with `0 < t < t_max`.
-    #[inline]
+    #[inline(always)]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<ShapeHit> {
         let (near, far) = self.roots(ray)?;
         if near > 0.0 && near < t_max {
@@ -51,7 +51,7 @@ impl Sphere {
     }
 
     /// Every crossing of the surface with `0 < t < t_max` (at most two).
-    #[inline]
+    #[inline(always)]
     pub fn crossings(&self, ray: &Ray, t_max: f64) -> Crossings {
         let mut out = Crossings::default();
         if let Some((near, far)) = self.roots(ray) {
