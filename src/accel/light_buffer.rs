@@ -35,6 +35,9 @@ const NEAR_LIGHT: f64 = 1e-8;
 /// At most this many shape-light pairs are projected (tens of
 /// milliseconds); a larger scene keeps no light buffer.
 const MAX_PAIRS: usize = 2_000_000;
+/// Fewer shape-light pairs than this are projected on the calling thread:
+/// waking a pool thread takes longer (100-200 µs) than projecting them.
+const PARALLEL_PAIRS: usize = 20_000;
 /// Lights after this many keep no cube (each takes 96 KiB and more).
 const MAX_CUBES: usize = 64;
 /// In a cube's `starts`: the cell's list was too long to keep.
@@ -111,15 +114,16 @@ impl LightBuffer {
             .max_abs()
             .max(f64::MIN_POSITIVE);
         let (pad, near) = (BOX_PAD * scale, NEAR_LIGHT * scale);
-        let cubes: Vec<Option<DirectionCube>> = lights
-            .par_iter()
-            .enumerate()
-            .map(|(i, &light)| {
-                (i < MAX_CUBES)
-                    .then(|| DirectionCube::build(&boxes, light, pad, near))
-                    .flatten()
-            })
-            .collect();
+        let cube = |(i, &light): (usize, &DVec3)| {
+            (i < MAX_CUBES)
+                .then(|| DirectionCube::build(&boxes, light, pad, near))
+                .flatten()
+        };
+        let cubes: Vec<Option<DirectionCube>> = if shapes.len() * lights.len() < PARALLEL_PAIRS {
+            lights.iter().enumerate().map(cube).collect()
+        } else {
+            lights.par_iter().enumerate().map(cube).collect()
+        };
         let kept = || cubes.iter().flatten();
         let unbounded: Vec<u32> = unbounded;
         let stats = LightBufferStats {

@@ -222,7 +222,8 @@ pub fn bench_scene(
     }
     let mut light_buffer_times = Vec::new();
     let mut light_buffer = None;
-    if settings.shadows {
+    let wants = |accel| Renderer::wants_light_buffer(&through(accel), &octree);
+    if wants(Accel::Octree) || (options.bvh && wants(Accel::Bvh)) {
         for _ in 0..options.repeat {
             check()?;
             let (buffer, s) = timed(|| pool.install(|| scene.build_light_buffer()));

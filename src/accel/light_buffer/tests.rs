@@ -239,7 +239,7 @@ fn crowded_cells_go_to_the_accelerator() {
         Candidates::Few([])
     ));
     let mut big = shapes.clone();
-    big.extend((0..8).map(|_| sphere(DVec3::ZERO, 100.0)));
+    big.extend((0..=MAX_LIST).map(|_| sphere(DVec3::ZERO, 100.0)));
     let inside = LightBuffer::build(&big, &[DVec3::ZERO]).unwrap();
     assert_eq!(inside.stats().cubes, 0, "every cell long: no cube");
     assert!(matches!(inside.candidates(0, DVec3::X), Candidates::Many));

@@ -340,6 +340,7 @@ fn sweep(args: &BenchArgs) -> Result<()> {
         say!("sweep {}", path.display());
         // Every setting's shadow rays ask the same light buffer first, as
         // a render's do: the sweep varies only the tree.
+        // (A one-leaf tree's renderer ignores it.)
         let light_buffer = pool.install(|| scene.build_light_buffer());
         // Unit costs once per scene, on its own octree setting, and how
         // the time per ray changes with the image's size (the scene's and
