@@ -277,7 +277,7 @@ impl PyScene {
         let (tree, build_s) = octree_for(slf, &snap, settings.use_octree, &pool)?;
         // Shadow rays ask a light buffer first, as `glint render`'s do;
         // a counted render walks (the buffer would hide the tree's work).
-        let light_buffer = (!stats && Renderer::wants_light_buffer(&settings, &tree))
+        let light_buffer = (!stats && Renderer::wants_light_buffer(&snap.scene, &settings, &tree))
             .then(|| pool.install(|| snap.scene.build_light_buffer()))
             .flatten();
         let renderer = Renderer::with_camera(&snap.scene, &tree, settings, &snap.scene.camera)

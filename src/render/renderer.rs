@@ -247,6 +247,13 @@ struct Routes {
     uncounted_packets: bool,
 }
 
+/// A scene of fewer shapes than this whose octree is one leaf (so its
+/// shadow rays go brute force) gets no light buffer: whole runs of
+/// sphere.toml, triangle.toml and lights.toml (1-3 spheres and a plane)
+/// took 5-8 % longer with one, while quadrics.toml (5 quadrics and a
+/// plane) took 6 % less.
+const LIGHT_BUFFER_MIN_SHAPES: usize = 5;
+
 /// A scene prepared for rendering with fixed settings.
 pub struct Renderer<'a> {
     pub(super) scene: &'a Scene,
@@ -436,22 +443,23 @@ impl<'a> Renderer<'a> {
     /// accelerator's.
     pub fn with_light_buffer(mut self, buffer: Option<&'a LightBuffer>) -> Self {
         let lights: Vec<_> = self.scene.lights.iter().map(|l| l.position).collect();
-        let useful = Self::wants_light_buffer(&self.settings, self.octree);
+        let useful = Self::wants_light_buffer(self.scene, &self.settings, self.octree);
         self.light_buffer = buffer.filter(|b| useful && b.fits(self.scene.shapes.len(), &lights));
         self
     }
 
-    /// Whether a render with `settings` over `octree` would ask a light
-    /// buffer (so whether to build one): with shadows, through the BVH or
-    /// an octree of more than one leaf. Brute force stays brute force, and
-    /// a one-leaf tree's scene of a few shapes answers a shadow ray by
-    /// brute force faster than a look-up and a list (sphere.toml and
-    /// triangle.toml: 5-7 % longer whole runs with it).
-    pub fn wants_light_buffer(settings: &RenderSettings, octree: &Octree) -> bool {
+    /// Whether a render of `scene` with `settings` over `octree` would
+    /// ask a light buffer (so whether to build one): with shadows, through
+    /// the BVH or the octree. Brute force stays brute force, and a one-leaf
+    /// tree's scene of fewer than [`LIGHT_BUFFER_MIN_SHAPES`] shapes
+    /// answers a shadow ray by brute force faster than a look-up and a list.
+    pub fn wants_light_buffer(scene: &Scene, settings: &RenderSettings, octree: &Octree) -> bool {
         settings.shadows
             && match settings.accel() {
                 Accel::Bvh => true,
-                Accel::Octree => !octree.is_one_leaf(),
+                Accel::Octree => {
+                    !octree.is_one_leaf() || scene.shapes.len() >= LIGHT_BUFFER_MIN_SHAPES
+                }
                 Accel::BruteForce => false,
             }
     }

@@ -222,7 +222,7 @@ pub fn bench_scene(
     }
     let mut light_buffer_times = Vec::new();
     let mut light_buffer = None;
-    let wants = |accel| Renderer::wants_light_buffer(&through(accel), &octree);
+    let wants = |accel| Renderer::wants_light_buffer(scene, &through(accel), &octree);
     if wants(Accel::Octree) || (options.bvh && wants(Accel::Bvh)) {
         for _ in 0..options.repeat {
             check()?;

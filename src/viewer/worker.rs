@@ -453,7 +453,7 @@ fn render_job(shared: &Shared, generation: u64, job: &Job, light_buffers: &mut L
         }
         settings.shadows = p.shadows;
     }
-    let light_buffer = Renderer::wants_light_buffer(&settings, &job.octree)
+    let light_buffer = Renderer::wants_light_buffer(&job.scene, &settings, &job.octree)
         .then(|| light_buffers.get(&job.scene))
         .flatten();
     let renderer = match Renderer::with_camera(&job.scene, &job.octree, settings, &job.camera) {

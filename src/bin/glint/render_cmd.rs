@@ -246,7 +246,7 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
     let build_s = build_start.elapsed().as_secs_f64();
     // `--stats` renders counting the accelerator's work, which the
     // buffer would hide: there it is not built.
-    let light_buffer = (Renderer::wants_light_buffer(&settings, &octree) && !args.stats)
+    let light_buffer = (Renderer::wants_light_buffer(&scene, &settings, &octree) && !args.stats)
         .then(|| {
             let start = Instant::now();
             let built = pool.install(|| scene.build_light_buffer())?;
