@@ -451,7 +451,7 @@ impl<'a> Renderer<'a> {
     /// Whether a render of `scene` with `settings` over `octree` would
     /// ask a light buffer (so whether to build one): with shadows, through
     /// the BVH or the octree. Brute force stays brute force, and a one-leaf
-    /// tree's scene of fewer than [`LIGHT_BUFFER_MIN_SHAPES`] shapes
+    /// tree's scene of fewer than five shapes
     /// answers a shadow ray by brute force faster than a look-up and a list.
     pub fn wants_light_buffer(scene: &Scene, settings: &RenderSettings, octree: &Octree) -> bool {
         settings.shadows
