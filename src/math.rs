@@ -148,6 +148,13 @@ pub fn offset_ray_origin(point: DVec3, normal: DVec3, floor_scale: f64) -> DVec3
     point + normal * magnitude * OFFSET_RELATIVE
 }
 
+/// How far short of `point` a ray aimed at it stops: the largest move
+/// [`offset_ray_origin`] would make there, so a segment's end is kept off
+/// a surface through it as its start is.
+pub fn offset_distance(point: DVec3, floor_scale: f64) -> f64 {
+    point.abs().max_element().max(floor_scale) * OFFSET_RELATIVE
+}
+
 /// Mirror direction of `dir` about the unit normal `n`.
 pub fn reflect(dir: DVec3, n: DVec3) -> DVec3 {
     dir - 2.0 * dir.dot(n) * n

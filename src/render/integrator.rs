@@ -4,7 +4,7 @@
 //! ray), each traced recursively to the depth limit (Whitted 1980).
 
 use crate::accel::ClosestHit;
-use crate::math::{Color, DVec3, Ray, offset_ray_origin, reflect, refract};
+use crate::math::{Color, DVec3, Ray, offset_distance, offset_ray_origin, reflect, refract};
 use crate::render::ray_tree::{HitRecord, RayKind, RayRecorder, ShadowRecord, ShadowVerdict};
 use crate::settings::Protocol;
 use crate::shapes::{PreparedRay, Shape};
@@ -202,8 +202,9 @@ impl Renderer<'_> {
         offset_ray_origin(at.shadow_point, at.facing, self.floor_scale)
     }
 
-    /// The direction to `light` from `origin`, its distance and the cosine
-    /// at the surface; `None` where the surface faces away from the light
+    /// The direction to `light` from `origin`, how far its shadow ray
+    /// reaches (the distance less [`offset_distance`]) and the cosine at
+    /// the surface; `None` where the surface faces away from the light
     /// (or the light sits on the origin): then it gets neither light nor a
     /// shadow ray. On a flat surface glint asks the geometric normal too
     /// (an interpolated normal can face the light where the surface itself
@@ -228,13 +229,18 @@ impl Renderer<'_> {
             return None;
         }
         let l = to_light / distance;
+        // The shadow ray stops short of the light as far as it starts off
+        // its surface: a light set in a surface (a lamp in a ceiling) is
+        // then neither hidden nor shown by that surface point by point as
+        // rounding falls, where the ray meets it at the light itself.
+        let reach = (distance - offset_distance(light.position, self.floor_scale)).max(0.0);
         let n_dot_l = at.normal.dot(l);
         let faces_away = match self.settings.protocol {
             Protocol::Glint if at.smooth => n_dot_l <= 0.0,
             Protocol::Glint => n_dot_l <= 0.0 || at.facing.dot(l) <= 0.0,
             Protocol::Spd => n_dot_l <= 0.0,
         };
-        (!faces_away).then_some((l, distance, n_dot_l))
+        (!faces_away).then_some((l, reach, n_dot_l))
     }
 
     /// Tells `rec` that light `index` faces away from the point.

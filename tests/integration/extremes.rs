@@ -3,7 +3,7 @@
 
 use crate::common;
 
-use common::{diff, load, render_with};
+use common::{diff, load, render_with, scene_from};
 use glint::accel::Octree;
 use glint::camera::{Camera, CameraSpec};
 use glint::math::{DVec3, Ray};
@@ -644,4 +644,43 @@ fn extreme_values_in_every_key_are_refused_or_render_finite() {
         rendered > refused,
         "{rendered} rendered, {refused} refused, {not_rendered} not rendered"
     );
+}
+
+/// A light on a surface (a lamp set into a ceiling) neither lights nor
+/// shadows a point through that surface as rounding falls: a floor seen
+/// from below the ceiling renders the same bytes with the ceiling's
+/// triangle around the light as without it. The camera looks down, so no
+/// eye ray meets the triangle.
+#[test]
+fn a_light_inside_a_surface_casts_no_speckled_shadow() {
+    let scene = |with_ceiling: bool| {
+        let ceiling = if with_ceiling {
+            "[[objects]]\nkind = \"triangle\"\nmaterial = \"white\"\n\
+             vertices = [[-3, -2, 0.3], [4, -1, 0.3], [-1, 5, 0.3]]\n"
+        } else {
+            ""
+        };
+        let text = format!(
+            "[camera]\neye = [0.3, -0.2, -0.6]\nlookat = [0.1, 0.2, -2]\nup = [0, 1, 0]\nfov = 70\n\
+             [image]\nwidth = 96\nheight = 72\nsamples = 1\n\
+             [materials.white]\ncolor = [0.9, 0.9, 0.9]\nkd = 0.9\n\
+             [[lights]]\nposition = [0.25, 0.5, 0.3]\ncolor = [1, 1, 1]\n\
+             [[objects]]\nkind = \"plane\"\nmaterial = \"white\"\npoint = [0, 0, -2]\nnormal = [0, 0, 1]\n\
+             {ceiling}"
+        );
+        scene_from(&text, "ceiling.toml")
+    };
+    let (open, lit) = (scene(false), scene(true));
+    for use_octree in [true, false] {
+        let render = |s: &glint::scene::Scene| {
+            let octree = s.build_octree().unwrap();
+            render_with(s, &octree, 96, 72, |st| st.use_octree = use_octree).0
+        };
+        let (a, b) = (render(&open), render(&lit));
+        let differing = a.chunks(3).zip(b.chunks(3)).filter(|(x, y)| x != y).count();
+        assert_eq!(
+            differing, 0,
+            "octree {use_octree}: {differing} pixels speckled"
+        );
+    }
 }
