@@ -245,6 +245,19 @@ fn timing_grid_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
                     ),
                 );
             }
+            if let Some((stats, seconds)) = info.worker.light_buffer() {
+                // Lights without a cube walk the accelerator.
+                let lights = if stats.cubes == stats.lights {
+                    format!("{} lights", stats.lights)
+                } else {
+                    format!("{} of {} lights", stats.cubes, stats.lights)
+                };
+                let kib = stats.memory_bytes as f64 / 1024.0;
+                row(
+                    "light buffer",
+                    format!("{seconds:.3} s, {lights}, {kib:.0} KiB"),
+                );
+            }
             row("shapes", format!("{}", edit.scene.shapes.len()));
         });
     ui.separator();

@@ -93,6 +93,9 @@ struct Shared {
     /// The octree switch of the last full job rendered: a job that flips
     /// it always renders, its time being what the user toggled to see.
     last_octree_switch: Mutex<Option<crate::settings::Accel>>,
+    /// What the last job's light buffer holds and its build's seconds
+    /// (`None`: the job asked none), for the Timing panel.
+    light_buffer: Mutex<Option<(crate::accel::LightBufferStats, f64)>>,
 }
 
 /// While the user drags: the generation of the preview in flight (sent or
@@ -174,6 +177,7 @@ impl Worker {
             previews_dropped: AtomicU64::new(0),
             full_generation: AtomicU64::new(0),
             last_octree_switch: Mutex::new(None),
+            light_buffer: Mutex::new(None),
         });
         let (tx, rx) = channel();
         let thread_shared = Arc::clone(&shared);
@@ -201,6 +205,16 @@ impl Worker {
     }
 
     /// How many threads render.
+    /// What the newest job's light buffer holds and its build's seconds
+    /// (`None` when the job asked none).
+    pub fn light_buffer(&self) -> Option<(crate::accel::LightBufferStats, f64)> {
+        *self
+            .shared
+            .light_buffer
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+    }
+
     pub fn threads(&self) -> usize {
         self.threads
     }
@@ -422,6 +436,8 @@ struct LightBufferCache {
     /// The geometry it was built over (a scene's clone shares it).
     shapes: Option<Arc<Vec<crate::shapes::Shape>>>,
     buffer: Option<crate::accel::LightBuffer>,
+    /// Its build's seconds.
+    seconds: f64,
 }
 
 impl LightBufferCache {
@@ -433,7 +449,9 @@ impl LightBufferCache {
             .is_some_and(|s| Arc::ptr_eq(s, &scene.shapes));
         let fits = |b: &crate::accel::LightBuffer| b.fits(scene.shapes.len(), &lights);
         if !same_shapes || !self.buffer.as_ref().is_some_and(fits) {
+            let start = Instant::now();
             self.buffer = scene.build_light_buffer();
+            self.seconds = start.elapsed().as_secs_f64();
             self.shapes = Some(Arc::clone(&scene.shapes));
         }
         self.buffer.as_ref()
@@ -453,9 +471,18 @@ fn render_job(shared: &Shared, generation: u64, job: &Job, light_buffers: &mut L
         }
         settings.shadows = p.shadows;
     }
-    let light_buffer = Renderer::wants_light_buffer(&job.scene, &settings, &job.octree)
-        .then(|| light_buffers.get(&job.scene))
-        .flatten();
+    let wants = Renderer::wants_light_buffer(&job.scene, &settings, &job.octree);
+    let light_buffer = if wants {
+        light_buffers.get(&job.scene);
+        light_buffers.buffer.as_ref()
+    } else {
+        None
+    };
+    *shared
+        .light_buffer
+        .lock()
+        .unwrap_or_else(|e| e.into_inner()) =
+        light_buffer.map(|b| (b.stats(), light_buffers.seconds));
     let renderer = match Renderer::with_camera(&job.scene, &job.octree, settings, &job.camera) {
         Ok(r) => match &job.bvh {
             Some(bvh) => r.with_bvh(bvh),
