@@ -96,17 +96,13 @@ impl LightBuffer {
         if lights.is_empty() || shapes.len().saturating_mul(lights.len()) > MAX_PAIRS {
             return None;
         }
-        let boxes: Vec<(u32, Aabb)> = shapes
-            .iter()
-            .enumerate()
-            .filter_map(|(i, s)| Some((i as u32, s.bounds()?)))
-            .collect();
-        let unbounded = shapes
-            .iter()
-            .enumerate()
-            .filter(|(_, s)| s.bounds().is_none())
-            .map(|(i, _)| i as u32)
-            .collect();
+        let (mut boxes, mut unbounded) = (Vec::new(), Vec::new());
+        for (i, shape) in shapes.iter().enumerate() {
+            match shape.bounds() {
+                Some(b) => boxes.push((i as u32, b)),
+                None => unbounded.push(i as u32),
+            }
+        }
         // The magnitude of every point a shadow ray's hit is computed from.
         let scale = boxes
             .iter()
@@ -125,7 +121,6 @@ impl LightBuffer {
             lights.par_iter().enumerate().map(cube).collect()
         };
         let kept = || cubes.iter().flatten();
-        let unbounded: Vec<u32> = unbounded;
         let stats = LightBufferStats {
             cubes: kept().count(),
             lights: lights.len(),

@@ -204,7 +204,6 @@ impl Worker {
         }
     }
 
-    /// How many threads render.
     /// What the newest job's light buffer holds and its build's seconds
     /// (`None` when the job asked none).
     pub fn light_buffer(&self) -> Option<(crate::accel::LightBufferStats, f64)> {
@@ -215,6 +214,7 @@ impl Worker {
             .unwrap_or_else(|e| e.into_inner())
     }
 
+    /// How many threads render.
     pub fn threads(&self) -> usize {
         self.threads
     }
@@ -441,7 +441,9 @@ struct LightBufferCache {
 }
 
 impl LightBufferCache {
-    fn get(&mut self, scene: &crate::scene::Scene) -> Option<&crate::accel::LightBuffer> {
+    /// The buffer of `scene`'s shapes and lights, built now if the kept
+    /// one is of others, and its build's seconds.
+    fn get(&mut self, scene: &crate::scene::Scene) -> Option<(&crate::accel::LightBuffer, f64)> {
         let lights: Vec<_> = scene.lights.iter().map(|l| l.position).collect();
         let same_shapes = self
             .shapes
@@ -454,7 +456,7 @@ impl LightBufferCache {
             self.seconds = start.elapsed().as_secs_f64();
             self.shapes = Some(Arc::clone(&scene.shapes));
         }
-        self.buffer.as_ref()
+        self.buffer.as_ref().map(|b| (b, self.seconds))
     }
 }
 
@@ -471,18 +473,14 @@ fn render_job(shared: &Shared, generation: u64, job: &Job, light_buffers: &mut L
         }
         settings.shadows = p.shadows;
     }
-    let wants = Renderer::wants_light_buffer(&job.scene, &settings, &job.octree);
-    let light_buffer = if wants {
-        light_buffers.get(&job.scene);
-        light_buffers.buffer.as_ref()
-    } else {
-        None
-    };
+    let built = Renderer::wants_light_buffer(&job.scene, &settings, &job.octree)
+        .then(|| light_buffers.get(&job.scene))
+        .flatten();
+    let light_buffer = built.map(|(b, _)| b);
     *shared
         .light_buffer
         .lock()
-        .unwrap_or_else(|e| e.into_inner()) =
-        light_buffer.map(|b| (b.stats(), light_buffers.seconds));
+        .unwrap_or_else(|e| e.into_inner()) = built.map(|(b, seconds)| (b.stats(), seconds));
     let renderer = match Renderer::with_camera(&job.scene, &job.octree, settings, &job.camera) {
         Ok(r) => match &job.bvh {
             Some(bvh) => r.with_bvh(bvh),

@@ -455,7 +455,6 @@ fn report(
         Some(bvh) => stats.with_bvh(bvh.stats()),
         None => stats,
     };
-
     out!("{}", serde_json::to_string_pretty(&stats)?)?;
     Ok(())
 }

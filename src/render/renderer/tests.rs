@@ -6,6 +6,16 @@ use crate::math::{DVec3, Ray};
 use crate::scene::ImageSettings;
 use crate::stats::WorkCounts;
 
+/// A deterministic stream of numbers in `[0, 1)` (an LCG) from `seed`.
+fn uniform_from(mut state: u64) -> impl FnMut() -> f64 {
+    move || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 fn scene_of(shapes: Vec<crate::shapes::Shape>) -> Scene {
     let camera = CameraSpec {
         eye: DVec3::new(0.0, 0.0, 10.0),
@@ -47,13 +57,7 @@ fn shadow_hints_change_no_answer() {
     let octree = scene.build_octree().unwrap();
     let renderer = Renderer::new(&scene, &octree, scene.render_settings()).unwrap();
     assert!(renderer.shadow_hints);
-    let mut state = 0x2545_f491_4f6c_dd1du64;
-    let mut uniform = move || {
-        state = state
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1);
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut uniform = uniform_from(0x2545_f491_4f6c_dd1d);
     let mut scratch = Scratch::default();
     let (mut blocked, mut answered_by_hint) = (0, 0);
     for run in 0..60 {
@@ -123,13 +127,7 @@ fn the_light_buffer_changes_no_answer() {
         .unwrap()
         .with_light_buffer(buffer.as_ref());
     assert!(buffered.has_light_buffer() && !plain.has_light_buffer());
-    let mut uniform = 0x853c_49e6_748f_ea9bu64;
-    let mut uniform = move || {
-        uniform = uniform
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1);
-        (uniform >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut uniform = uniform_from(0x853c_49e6_748f_ea9b);
     let (mut scratch, mut plain_scratch) = (Scratch::default(), Scratch::default());
     let (mut blocked, mut lit) = (0, 0);
     for n in 0..3_000 {

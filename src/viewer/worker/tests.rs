@@ -116,7 +116,8 @@ fn the_light_buffer_follows_moved_lights_and_new_geometry() {
     let mut cache = LightBufferCache::default();
     let fits = |c: &mut LightBufferCache, s: &crate::scene::Scene| {
         let lights: Vec<_> = s.lights.iter().map(|l| l.position).collect();
-        c.get(s).is_some_and(|b| b.fits(s.shapes.len(), &lights))
+        c.get(s)
+            .is_some_and(|(b, _)| b.fits(s.shapes.len(), &lights))
     };
     let address = |c: &LightBufferCache| c.buffer.as_ref().map(|b| b as *const _);
     assert!(fits(&mut cache, &scene));
