@@ -372,7 +372,9 @@ impl Renderer<'_> {
             Protocol::Glint => reflect_weight > 0.0,
             Protocol::Spd => material.reflectivity > 0.0 || material.transparency > 0.0,
         };
-        let reflection = spawn_reflection.then(|| {
+        // An `if`, not `bool::then`: a closure the compiler keeps apart is
+        // compiled without the SIMD level of the packet code calling this.
+        let reflection = if spawn_reflection {
             rays.reflection += 1;
             let mut dir = reflect(ray.dir, n);
             // An interpolated normal can send the mirror ray below the
@@ -381,12 +383,14 @@ impl Renderer<'_> {
                 dir = reflect(ray.dir, facing);
             }
             let origin = offset_ray_origin(p, facing, self.floor_scale);
-            Secondary {
+            Some(Secondary {
                 kind: RayKind::Reflection,
                 ray: Ray::new(origin, dir.normalize()),
                 weight: reflect_weight,
-            }
-        });
+            })
+        } else {
+            None
+        };
         [refraction, reflection]
     }
 }

@@ -161,8 +161,10 @@ impl Renderer<'_> {
                     let mut i = tile.x;
                     while i < tile.x + tile.width {
                         let n = N.min((tile.x + tile.width - i) as usize);
-                        let rays: [Ray; N] =
-                            std::array::from_fn(|k| self.camera.ray(i + k as u32, j, 0.5, 0.5));
+                        let mut rays = [Ray::new(DVec3::ZERO, DVec3::X); N];
+                        for (k, ray) in rays.iter_mut().enumerate() {
+                            *ray = self.camera.ray(i + k as u32, j, 0.5, 0.5);
+                        }
                         let values = if signatures {
                             let mut recs = [Signature::default(); N];
                             let v = self.sample_lanes(
@@ -200,8 +202,10 @@ impl Renderer<'_> {
                     let mut i = tile.x;
                     while i < tile.x + tile.width {
                         let n = N.min((tile.x + tile.width - i) as usize);
-                        let rays: [Ray; N] =
-                            std::array::from_fn(|k| self.camera.ray(i + k as u32, j, 0.0, 0.0));
+                        let mut rays = [Ray::new(DVec3::ZERO, DVec3::X); N];
+                        for (k, ray) in rays.iter_mut().enumerate() {
+                            *ray = self.camera.ray(i + k as u32, j, 0.0, 0.0);
+                        }
                         let mut recs = [NoRecord; N];
                         let values = self.sample_lanes(
                             simd,
@@ -249,10 +253,11 @@ impl Renderer<'_> {
     ) -> DVec3 {
         let mut pixel = PixelSum::default();
         for chunk in self.grid.chunks(N) {
-            let rays: [Ray; N] = std::array::from_fn(|k| {
+            let mut rays = [Ray::new(DVec3::ZERO, DVec3::X); N];
+            for (k, ray) in rays.iter_mut().enumerate() {
                 let (dx, dy) = chunk[k.min(chunk.len() - 1)];
-                self.camera.ray(i, j, dx, dy)
-            });
+                *ray = self.camera.ray(i, j, dx, dy);
+            }
             let mut recs = [NoRecord; N];
             let values =
                 self.sample_lanes(simd, &rays[..chunk.len()], query, stack, counts, &mut recs);
@@ -280,13 +285,11 @@ impl Renderer<'_> {
         let mut values = if self.settings.view.traces_shading() {
             self.shade_lanes(simd, rays, &hits, query, stack, &mut counts.rays, recs)
         } else {
-            std::array::from_fn(|k| {
-                if k < rays.len() {
-                    self.inspect_hit(&rays[k], hits[k].as_ref(), &mut counts.rays)
-                } else {
-                    DVec3::ZERO
-                }
-            })
+            let mut values = [DVec3::ZERO; N];
+            for (k, ray) in rays.iter().enumerate() {
+                values[k] = self.inspect_hit(ray, hits[k].as_ref(), &mut counts.rays);
+            }
+            values
         };
         for v in values.iter_mut().take(rays.len()) {
             if !v.is_finite() {
@@ -318,24 +321,26 @@ impl Renderer<'_> {
                 stack: &mut stack.walk,
                 counter: &mut *query.counter,
             });
-            return std::array::from_fn(|k| {
-                (k < rays.len() && best.shape[k] != PacketHits::<N>::NONE).then(|| ClosestHit {
-                    shape: best.shape[k],
-                    hit: ShapeHit {
-                        t: best.t[k],
-                        b1: best.b1[k],
-                        b2: best.b2[k],
-                    },
-                })
-            });
-        }
-        std::array::from_fn(|k| {
-            if k < rays.len() {
-                self.closest(&PreparedRay::new(rays[k]), query)
-            } else {
-                None
+            let mut hits = [None; N];
+            for k in 0..rays.len() {
+                if best.shape[k] != PacketHits::<N>::NONE {
+                    hits[k] = Some(ClosestHit {
+                        shape: best.shape[k],
+                        hit: ShapeHit {
+                            t: best.t[k],
+                            b1: best.b1[k],
+                            b2: best.b2[k],
+                        },
+                    });
+                }
             }
-        })
+            return hits;
+        }
+        let mut hits = [None; N];
+        for (k, ray) in rays.iter().enumerate() {
+            hits[k] = self.closest(&PreparedRay::new(*ray), query);
+        }
+        hits
     }
 
     /// The colours of eye rays that met `hits`: what
@@ -424,17 +429,23 @@ impl Renderer<'_> {
                 }
             }
         }
-        let origins: [DVec3; N] = std::array::from_fn(|k| {
-            points[k]
-                .as_ref()
-                .map_or(DVec3::ZERO, |at| self.shadow_origin(at))
-        });
+        // Loops, not `std::array::from_fn`: its closures, once too large to
+        // inline (as `toward_light` became), are compiled apart from this
+        // function's SIMD level, and calling them cost the default scene a
+        // third more time at 1 spp (2026-11-28).
+        let mut origins = [DVec3::ZERO; N];
+        for k in 0..n {
+            if let Some(at) = &points[k] {
+                origins[k] = self.shadow_origin(at);
+            }
+        }
         for (index, light) in self.scene.lights.iter().enumerate() {
-            let toward: [Option<(DVec3, f64, f64)>; N] = std::array::from_fn(|k| {
-                points[k]
-                    .as_ref()
-                    .and_then(|at| self.toward_light(at, origins[k], light))
-            });
+            let mut toward: [Option<(DVec3, f64, f64)>; N] = [None; N];
+            for k in 0..n {
+                if let Some(at) = &points[k] {
+                    toward[k] = self.toward_light(at, origins[k], light);
+                }
+            }
             let passes = if self.settings.shadows {
                 self.transmittance_lanes(&origins, &toward, index, query, ray_counts)
             } else {
