@@ -47,7 +47,7 @@ impl Triangle {
     /// Watertight ray/triangle intersection: Woop, Benthin & Wald,
     /// "Watertight Ray/Triangle Intersection", JCGT 2(1), 2013. Rays through
     /// a shared edge or vertex hit at least one of the triangles that share it.
-    #[inline]
+    #[inline(always)]
     pub fn intersect(&self, r: &PreparedRay, t_max: f64) -> Option<ShapeHit> {
         // The axes are a run-time choice per ray: dispatching once to code
         // with constant axes avoids indexing vectors by a variable.
