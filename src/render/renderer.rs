@@ -592,7 +592,7 @@ impl<'a> Renderer<'a> {
         }
         let route = self.route::<C>();
         let few = match self.light_buffer {
-            Some(buffer) if !C::COUNTS => match buffer.candidates(light, ray.ray.dir) {
+            Some(buffer) if !C::COUNTS => match buffer.candidates(light, ray) {
                 Candidates::Few(list) => Some([buffer.unbounded(), list]),
                 Candidates::Many => None,
             },

@@ -117,6 +117,23 @@ impl PreparedRay {
         }
     }
 
+    /// The direction's dominant axis and its components along the next two
+    /// axes in cyclic order over the dominant one's magnitude: where it
+    /// meets a cube of directions, read off the watertight test's shear
+    /// without a division (bit for bit those quotients: dividing by the
+    /// negated component only flips the sign).
+    #[inline(always)]
+    pub fn cube_face(&self) -> (usize, f64, f64) {
+        let major = (self.permutation / 2) as usize;
+        // Up the dominant axis the shear holds the next axis then the one
+        // after; down it, the two swapped, over a negative component.
+        if self.permutation & 1 == 0 {
+            (major, self.shear.x, self.shear.y)
+        } else {
+            (major, -self.shear.y, -self.shear.x)
+        }
+    }
+
     /// The permutation's axes `(kx, ky, kz)`: `kz` the dominant one, the
     /// others in cyclic order, swapped when the dominant component is
     /// negative.

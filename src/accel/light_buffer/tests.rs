@@ -24,6 +24,11 @@ impl Uniform {
     }
 }
 
+/// A ray from the origin along `dir`.
+fn along(dir: DVec3) -> PreparedRay {
+    PreparedRay::new(Ray::new(DVec3::ZERO, dir))
+}
+
 /// How a scene's shadow rays went.
 #[derive(Debug, Default)]
 struct Tally {
@@ -78,7 +83,7 @@ fn check(shapes: &[Shape], lights: &[DVec3], transparent: &[bool], rays: usize) 
         let mut expected = ShadowCrossings::default();
         occlusion_brute_force(&prims, &ray, distance, &mut expected, &mut NoCounts);
         tally.blocked += expected.is_blocked() as usize;
-        match buffer.candidates(light_index, ray.ray.dir) {
+        match buffer.candidates(light_index, &ray) {
             Candidates::Few(list) => {
                 tally.few += 1;
                 tally.listed += !list.is_empty() as usize;
@@ -204,7 +209,7 @@ fn rays_along_the_cube_edges_and_axes_answer_as_brute_force() {
         let to_light = light - origin;
         let distance = to_light.length();
         let ray = PreparedRay::new(Ray::new(origin, to_light / distance));
-        let Candidates::Few(list) = buffer.candidates(0, ray.ray.dir) else {
+        let Candidates::Few(list) = buffer.candidates(0, &ray) else {
             panic!("ray {i}: a few spheres per cell")
         };
         let mut found = ShadowCrossings::default();
@@ -231,18 +236,18 @@ fn crowded_cells_go_to_the_accelerator() {
         .collect();
     let beyond = LightBuffer::build(&shapes, &[DVec3::ZERO]).unwrap();
     assert!(matches!(
-        beyond.candidates(0, DVec3::NEG_X),
+        beyond.candidates(0, &along(DVec3::NEG_X)),
         Candidates::Many
     ));
     assert!(matches!(
-        beyond.candidates(0, DVec3::X),
+        beyond.candidates(0, &along(DVec3::X)),
         Candidates::Few([])
     ));
     let mut big = shapes.clone();
     big.extend((0..=MAX_LIST).map(|_| sphere(DVec3::ZERO, 100.0)));
     let inside = LightBuffer::build(&big, &[DVec3::ZERO]).unwrap();
     assert_eq!(inside.stats().cubes, 0, "every cell long: no cube");
-    assert!(matches!(inside.candidates(0, DVec3::X), Candidates::Many));
+    assert!(matches!(inside.candidates(0, &along(DVec3::X)), Candidates::Many));
 }
 
 #[test]
@@ -255,7 +260,7 @@ fn a_buffer_fits_only_its_own_lights_and_shapes() {
     assert!(!buffer.fits(1, &[DVec3::new(0.0, 5.0, 1e-12)]));
     assert!(LightBuffer::build(&shapes, &[]).is_none());
     // A light with no cube answers "ask the accelerator".
-    assert!(matches!(buffer.candidates(7, DVec3::X), Candidates::Many));
+    assert!(matches!(buffer.candidates(7, &along(DVec3::X)), Candidates::Many));
 }
 
 #[test]
@@ -287,4 +292,30 @@ fn counts_by_difference_table_match_counting_cell_by_cell() {
         }
     }
     assert_eq!(cell_counts(&rects), direct);
+}
+
+#[test]
+fn a_rays_cell_from_its_shear_is_the_cell_of_its_reversed_direction() {
+    // Every face and its edges and corners, where the dominant axis is a
+    // tie; zero and negative-zero components; random directions; and
+    // components far apart in magnitude. The zero direction lands in
+    // cell 0 both ways.
+    let mut dirs = Vec::new();
+    let values = [-1.0, -0.5, -1e-300, -0.0, 0.0, 1e-300, 0.5, 1.0];
+    for &x in &values {
+        for &y in &values {
+            for &z in &values {
+                dirs.push(DVec3::new(x, y, z));
+            }
+        }
+    }
+    let mut uniform = Uniform(7);
+    for _ in 0..20_000 {
+        let d = uniform.point(Aabb::new(DVec3::splat(-1.0), DVec3::ONE));
+        dirs.push(d);
+        dirs.push(d * DVec3::new(1e-12, 1.0, 1e12));
+    }
+    for d in dirs {
+        assert_eq!(cell_of_ray(&along(d)), cell_of(-d), "direction {d:?}");
+    }
 }
