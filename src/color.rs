@@ -43,8 +43,9 @@ impl ColorConvention {
 
     /// A shaded value as the 8-bit channel written for it: exactly
     /// `to_byte(self.encode(x))`, but a linear value is looked up among
-    /// the 255 linear values at which the sRGB byte steps up (eight
-    /// comparisons instead of `powf` for every channel of every pixel).
+    /// the 255 linear values at which the sRGB byte steps up (a bucket's
+    /// start and a comparison or two instead of `powf` for every channel of
+    /// every pixel).
     #[inline]
     pub fn byte(self, x: f64) -> u8 {
         match self {
@@ -117,28 +118,50 @@ pub fn to_byte(x: f64) -> u8 {
     (whole + (y - whole as f64 >= 0.5) as u32) as u8
 }
 
+/// Buckets of [`SrgbTable::start`]: a power of two, so `x * BUCKETS` is
+/// exact and bucket `b` holds exactly the values in `[b, b + 1) / BUCKETS`.
+const BUCKETS: usize = 4096;
+
+/// The linear values at which the sRGB byte steps up, and where to start
+/// counting them for each bucket of `[0, 1]`.
+struct SrgbTable {
+    /// `steps[k]`: the least linear value whose sRGB byte is at least `k`
+    /// (`steps[0]` is unused).
+    steps: [f64; 256],
+    /// Per bucket, the steps at or below its lowest value: a value in the
+    /// bucket has at least these and, the steps being more than a bucket
+    /// apart (1/3,295 on sRGB's linear segment, wider above), one more at
+    /// most.
+    start: [u8; BUCKETS],
+}
+
 /// `to_byte(linear_to_srgb(x))` by table: the byte is the number of steps
 /// at or below `x` (both are monotonic in `x`; NaN and values below the
-/// first step give 0, as the formula does).
+/// first step give 0, as the formula does), counted from the bucket's
+/// start instead of by eight comparisons of a bisection.
 #[inline]
 fn srgb_byte(x: f64) -> u8 {
-    let steps = srgb_steps();
-    let mut k = 0;
-    for half in [128, 64, 32, 16, 8, 4, 2, 1] {
-        if x >= steps[k + half] {
-            k += half;
-        }
+    let table = srgb_table();
+    // NaN and negative values saturate to bucket 0, values from 1 up to
+    // the last bucket.
+    let bucket = ((x * BUCKETS as f64) as usize).min(BUCKETS - 1);
+    let mut k = table.start[bucket] as usize;
+    while k < 255 && x >= table.steps[k + 1] {
+        k += 1;
     }
     k as u8
 }
 
-/// `steps[k]`: the least linear value whose sRGB byte is at least `k`
-/// (`steps[0]` is unused), found once by bisecting the doubles of [0, 1]
-/// in their bit order with the formula itself, so the table cannot
-/// disagree with it.
+#[cfg(test)]
 fn srgb_steps() -> &'static [f64; 256] {
-    static STEPS: std::sync::OnceLock<[f64; 256]> = std::sync::OnceLock::new();
-    STEPS.get_or_init(|| {
+    &srgb_table().steps
+}
+
+/// The table, its steps found once by bisecting the doubles of [0, 1] in
+/// their bit order with the formula itself, so it cannot disagree with it.
+fn srgb_table() -> &'static SrgbTable {
+    static TABLE: std::sync::OnceLock<SrgbTable> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| {
         let byte = |bits: u64| to_byte(linear_to_srgb(f64::from_bits(bits)));
         let mut steps = [f64::NEG_INFINITY; 256];
         for (k, step) in steps.iter_mut().enumerate().skip(1) {
@@ -155,7 +178,16 @@ fn srgb_steps() -> &'static [f64; 256] {
             }
             *step = f64::from_bits(lo);
         }
-        steps
+        let mut start = [0u8; BUCKETS];
+        let mut k = 0;
+        for (b, first) in start.iter_mut().enumerate() {
+            let lowest = b as f64 / BUCKETS as f64;
+            while k < 255 && steps[k + 1] <= lowest {
+                k += 1;
+            }
+            *first = k as u8;
+        }
+        SrgbTable { steps, start }
     })
 }
 
@@ -183,9 +215,22 @@ mod tests {
             cases.extend((bits.saturating_sub(3)..=bits + 3).map(f64::from_bits));
         }
         cases.extend((0..=100_000).map(|k| k as f64 / 100_000.0));
+        // Every bucket's edges.
+        for b in 0..=BUCKETS {
+            let edge = b as f64 / BUCKETS as f64;
+            cases.extend([edge.next_down(), edge, edge.next_up()]);
+        }
         for x in cases {
             assert_eq!(ColorConvention::Linear.byte(x), formula(x), "x = {x:e}");
             assert_eq!(ColorConvention::Display.byte(x), to_byte(x), "x = {x:e}");
+        }
+        // No bucket holds two steps past its start (the loop takes at most
+        // one more step).
+        let table = srgb_table();
+        for b in 0..BUCKETS {
+            let (lo, hi) = (b as f64 / BUCKETS as f64, (b + 1) as f64 / BUCKETS as f64);
+            let inside = steps_in(&table.steps, lo, hi);
+            assert!(inside <= 1, "bucket {b}: {inside} steps inside");
         }
         // Monotonic steps, each a real step of the formula.
         let steps = srgb_steps();
@@ -194,6 +239,10 @@ mod tests {
             assert_eq!(formula(steps[k]) as usize, k);
             assert_eq!(formula(steps[k].next_down()) as usize, k - 1);
         }
+    }
+
+    fn steps_in(steps: &[f64; 256], lo: f64, hi: f64) -> usize {
+        steps[1..].iter().filter(|&&s| s > lo && s < hi).count()
     }
 
     #[test]

@@ -229,7 +229,13 @@ impl Frame {
         let range = self.cost_summary().map_or((0.0, 0.0), |c| (c.min, c.max));
         let encode = |p: &DVec3| -> [u8; 3] {
             match self.view {
-                ViewMode::Shaded => [p.x, p.y, p.z].map(|c| self.colors.byte(c)),
+                // Element by element, not `array::map`: its closure was a
+                // call per channel.
+                ViewMode::Shaded => [
+                    self.colors.byte(p.x),
+                    self.colors.byte(p.y),
+                    self.colors.byte(p.z),
+                ],
                 ViewMode::Normals => [p.x, p.y, p.z].map(to_byte),
                 ViewMode::Depth => [to_byte(depth_shade(*p, near.unwrap_or(0.0))); 3],
                 ViewMode::Cost | ViewMode::CostSteps => {

@@ -247,7 +247,10 @@ fn crowded_cells_go_to_the_accelerator() {
     big.extend((0..=MAX_LIST).map(|_| sphere(DVec3::ZERO, 100.0)));
     let inside = LightBuffer::build(&big, &[DVec3::ZERO]).unwrap();
     assert_eq!(inside.stats().cubes, 0, "every cell long: no cube");
-    assert!(matches!(inside.candidates(0, &along(DVec3::X)), Candidates::Many));
+    assert!(matches!(
+        inside.candidates(0, &along(DVec3::X)),
+        Candidates::Many
+    ));
 }
 
 #[test]
@@ -260,7 +263,10 @@ fn a_buffer_fits_only_its_own_lights_and_shapes() {
     assert!(!buffer.fits(1, &[DVec3::new(0.0, 5.0, 1e-12)]));
     assert!(LightBuffer::build(&shapes, &[]).is_none());
     // A light with no cube answers "ask the accelerator".
-    assert!(matches!(buffer.candidates(7, &along(DVec3::X)), Candidates::Many));
+    assert!(matches!(
+        buffer.candidates(7, &along(DVec3::X)),
+        Candidates::Many
+    ));
 }
 
 #[test]
