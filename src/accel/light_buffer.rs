@@ -14,9 +14,10 @@ use serde::Serialize;
 use crate::math::{Aabb, DVec3};
 use crate::shapes::{PreparedRay, Shape};
 
-/// Cells along a side of each of the cube's six faces: 128 took tree 8 %
-/// fewer instructions a ray than 64, balls, mount and teapot 2-4 %, and
-/// none more (192 gained another 1-3 % for 2.25 times the memory).
+/// Cells along a side of each of the cube's six faces: 128 took tree 7 %
+/// fewer instructions a ray than 64, mount 4 %, balls 3 %, teapot 2 %, and
+/// no scene more; 192 gained tree and balls another 2 % for 2.25 times the
+/// memory and cost mount its cube (docs/notes/experiments.md).
 const SIDE: usize = 128;
 const FACE_CELLS: usize = SIDE * SIDE;
 const CUBE_CELLS: usize = 6 * FACE_CELLS;
@@ -161,8 +162,8 @@ impl LightBuffer {
         &self.unbounded
     }
 
-    /// The bounded shapes a shadow ray towards light `light` along `dir`
-    /// (from the surface to the light) can meet.
+    /// The bounded shapes the shadow ray `ray` (from the surface to light
+    /// `light`) can meet.
     #[inline(always)]
     pub fn candidates(&self, light: usize, ray: &PreparedRay) -> Candidates<'_> {
         let Some(Some(cube)) = self.cubes.get(light) else {
