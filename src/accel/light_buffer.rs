@@ -41,8 +41,11 @@ const MAX_PAIRS: usize = 2_000_000;
 /// Fewer shape-light pairs than this are projected on the calling thread:
 /// waking a pool thread takes longer (100-200 µs) than projecting them.
 const PARALLEL_PAIRS: usize = 20_000;
-/// Lights after this many keep no cube (each takes 384 KiB and more).
-const MAX_CUBES: usize = 64;
+/// Lights after this many keep no cube. A cube takes 384 KiB of starts
+/// and at most `MAX_LIST` shapes a cell, 4.7 MiB: sixteen keep the bound
+/// sixty-four cubes of 64x64 cells had (an 80-light scene of 6,500 shapes
+/// took 75 MB at its peak with 64 cubes of 128x128, 29 MB before).
+const MAX_CUBES: usize = 16;
 /// In a cube's `starts`: the cell's list was too long to keep.
 const LONG: u32 = 1 << 31;
 
