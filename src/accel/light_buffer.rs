@@ -6,11 +6,16 @@
 //! brute force's, which every accelerator's is. Most shadow rays reach
 //! their light through a cell that lists nothing. A cell that would list
 //! more than [`MAX_LIST`] shapes (over a mesh, say) is left to the
-//! accelerator.
+//! accelerator, but for shadow rays from points nearer the light than
+//! all but its nearest few. Triangles and cones are listed where they
+//! themselves are seen, not their boxes (`projection.rs`).
+
+mod projection;
 
 use rayon::prelude::*;
 use serde::Serialize;
 
+use self::projection::{face_rect, merge_rows, triangle_rows};
 use crate::math::{Aabb, DVec3};
 use crate::shapes::{PreparedRay, Shape};
 
@@ -22,7 +27,9 @@ const SIDE: usize = 128;
 const FACE_CELLS: usize = SIDE * SIDE;
 const CUBE_CELLS: usize = 6 * FACE_CELLS;
 /// Longest list a cell keeps; a longer one goes to the accelerator (a
-/// shape test costs about a twentieth of a shadow ray's walk).
+/// shape test costs about a twentieth of a shadow ray's walk), except for
+/// the shadow rays that start nearer the light than its first `MAX_LIST`
+/// shapes leave (see [`DirectionCube`]).
 const MAX_LIST: usize = 12;
 /// Padding of a box's projection, in face coordinates (`[-1, 1]`): far
 /// more than the rounding of a ray's direction or of the projection.
@@ -42,20 +49,30 @@ const MAX_PAIRS: usize = 2_000_000;
 /// waking a pool thread takes longer (100-200 µs) than projecting them.
 const PARALLEL_PAIRS: usize = 20_000;
 /// Lights after this many keep no cube. A cube takes 384 KiB of starts
-/// and at most `MAX_LIST` shapes a cell, 4.7 MiB: sixteen keep the bound
-/// sixty-four cubes of 64x64 cells had (an 80-light scene of 6,500 shapes
-/// took 75 MB at its peak with 64 cubes of 128x128, 29 MB before).
+/// and at most `MAX_LIST + 1` entries of 8 bytes a cell, 10 MiB (an
+/// 80-light scene of 6,500 shapes took 75 MB at its peak with 64 cubes
+/// of 128x128, 29 MB with 16 of 4-byte entries, 36 MB with 16 of 8-byte
+/// entries; real scenes' cubes hold far less than the bound: gears' five
+/// 3.3 MB in all).
 const MAX_CUBES: usize = 16;
-/// In a cube's `starts`: the cell's list was too long to keep.
+/// In a cube's `starts`: the cell's list was too long to keep whole.
 const LONG: u32 = 1 << 31;
 
-/// One light's cube of directions.
+/// One light's cube of directions. Every list is sorted by how near its
+/// shapes' boxes come to the light, and a shadow ray tests only those
+/// nearer the light than its origin (no point of the ray is farther). A
+/// long cell keeps its `MAX_LIST` nearest, then the nearness of the first
+/// one left out: a shadow ray that starts nearer (a point lit through a
+/// crowded cell, on the first surface the light sees) is answered from
+/// them as from a short list.
 struct DirectionCube {
     /// Per cell, where its list starts in `shapes`, or [`LONG`] added for a
-    /// cell whose list was too long (it is empty); one more entry ends the
-    /// last list.
+    /// cell whose list was too long; one more entry ends the last list.
     starts: Vec<u32>,
     shapes: Vec<u32>,
+    /// Per entry of `shapes`, how near its box comes to the light, less
+    /// the padding, rounded down ([`reach_key`]).
+    nears: Vec<f32>,
 }
 
 /// What a light buffer holds, for `--stats` and the viewer.
@@ -102,11 +119,15 @@ impl LightBuffer {
         if lights.is_empty() || shapes.len().saturating_mul(lights.len()) > MAX_PAIRS {
             return None;
         }
+        // A shape's boxes, consecutive: one, or a cone's pieces.
         let (mut boxes, mut unbounded) = (Vec::new(), Vec::new());
         for (i, shape) in shapes.iter().enumerate() {
-            match shape.bounds() {
-                Some(b) => boxes.push((i as u32, b)),
-                None => unbounded.push(i as u32),
+            match shape {
+                Shape::Cone(cone) => boxes.extend(cone.cover().map(|b| (i as u32, b))),
+                _ => match shape.bounds() {
+                    Some(b) => boxes.push((i as u32, b)),
+                    None => unbounded.push(i as u32),
+                },
             }
         }
         // The magnitude of every point a shadow ray's hit is computed from.
@@ -118,7 +139,7 @@ impl LightBuffer {
         let (pad, near) = (BOX_PAD * scale, NEAR_LIGHT * scale);
         let cube = |(i, &light): (usize, &DVec3)| {
             (i < MAX_CUBES)
-                .then(|| DirectionCube::build(&boxes, light, pad, near))
+                .then(|| DirectionCube::build(shapes, &boxes, light, pad, near))
                 .flatten()
         };
         let cubes: Vec<Option<DirectionCube>> = if shapes.len() * lights.len() < PARALLEL_PAIRS {
@@ -127,16 +148,17 @@ impl LightBuffer {
             lights.par_iter().enumerate().map(cube).collect()
         };
         let kept = || cubes.iter().flatten();
+        let long_cells = kept()
+            .map(|c| c.starts.iter().filter(|&&s| s & LONG != 0).count())
+            .sum();
         let stats = LightBufferStats {
             cubes: kept().count(),
             lights: lights.len(),
-            long_cells: kept()
-                .map(|c| c.starts.iter().filter(|&&s| s & LONG != 0).count())
-                .sum(),
-            listed: kept().map(|c| c.shapes.len()).sum(),
+            long_cells,
+            listed: kept().map(|c| c.shapes.len()).sum::<usize>() - long_cells,
             memory_bytes: 4
                 * (kept()
-                    .map(|c| c.starts.len() + c.shapes.len())
+                    .map(|c| c.starts.len() + c.shapes.len() + c.nears.len())
                     .sum::<usize>()
                     + unbounded.len()) as u64,
         };
@@ -173,83 +195,215 @@ impl LightBuffer {
             return Candidates::Many;
         };
         let cell = cell_of_ray(ray);
-        let start = cube.starts[cell];
-        if start & LONG != 0 {
-            return Candidates::Many;
+        let (start, end) = (cube.starts[cell], cube.starts[cell + 1] & !LONG);
+        let first = (start & !LONG) as usize;
+        if first == end as usize {
+            // Most shadow rays: nothing in the way.
+            return Candidates::Few(&[]);
         }
-        let end = cube.starts[cell + 1] & !LONG;
-        Candidates::Few(&cube.shapes[start as usize..end as usize])
+        // The ray's points are no farther from the light than its origin:
+        // the shapes whose boxes keep farther off cannot meet it (a NaN
+        // keeps every one).
+        let reach = (ray.ray.origin - self.lights[light]).length_squared();
+        let beyond = |near: f32| f64::from(near) * f64::from(near) > reach;
+        let nears = &cube.nears[first..end as usize];
+        // Often the ray starts past them all (or, in a long cell, past
+        // those kept): one comparison.
+        let met = if nears.last().is_some_and(|&near| beyond(near)) {
+            nears.iter().take_while(|&&near| !beyond(near)).count()
+        } else if start & LONG != 0 {
+            return Candidates::Many;
+        } else {
+            nears.len()
+        };
+        Candidates::Few(&cube.shapes[first..first + met])
     }
+}
+
+/// One shape as a light sees it.
+struct Seen<'b> {
+    /// How near its boxes come (see [`Rect::near`]); 0 if `everywhere`.
+    near: f32,
+    /// So near the light (or so far out of range) that every direction
+    /// may meet it.
+    everywhere: bool,
+    boxes: &'b [(u32, Aabb)],
+    /// Where its whole box's rectangles start.
+    first_rect: usize,
 }
 
 /// The cells of one face a box can be seen through, as inclusive ranges.
 #[derive(Clone, Copy)]
 struct Rect {
     shape: u32,
+    /// How near the box comes to the light, less the padding, rounded
+    /// down: nothing of the shape a shadow ray can meet is nearer.
+    near: f32,
     face: u8,
     /// `[i0, i1, j0, j1]`: columns then rows.
     cells: [u8; 4],
 }
 
 impl DirectionCube {
-    fn build(boxes: &[(u32, Aabb)], light: DVec3, pad: f64, near: f64) -> Option<Self> {
-        let mut rects: Vec<Rect> = Vec::new();
-        for &(shape, b) in boxes {
-            let b = Aabb::new(b.min - pad - light, b.max + pad - light);
-            let gap = (b.min.max(DVec3::ZERO) + (-b.max).max(DVec3::ZERO)).length();
-            // A box beyond f64's range projects to no number: every cell.
-            let everywhere = gap <= near || !(b.min.is_finite() && b.max.is_finite());
+    fn build(
+        scene: &[Shape],
+        boxes: &[(u32, Aabb)],
+        light: DVec3,
+        pad: f64,
+        near: f64,
+    ) -> Option<Self> {
+        let mut groups: Vec<Seen> = Vec::new();
+        // Whole boxes' rectangles first: cheap, and enough to tell a cube
+        // of mostly long lists, which is not kept.
+        let mut whole_rects: Vec<Rect> = Vec::new();
+        for group in boxes.chunk_by(|a, b| a.0 == b.0) {
+            let (mut key, mut everywhere, mut whole) = (f32::INFINITY, false, Aabb::EMPTY);
+            for &(_, b) in group {
+                let b = Aabb::new(b.min - pad - light, b.max + pad - light);
+                let gap = (b.min.max(DVec3::ZERO) + (-b.max).max(DVec3::ZERO)).length();
+                // A box beyond f64's range projects to no number: every cell.
+                everywhere |= gap <= near || !(b.min.is_finite() && b.max.is_finite());
+                key = key.min(reach_key(gap - pad));
+                whole = whole.union(b);
+            }
+            let key = if everywhere { 0.0 } else { key };
+            groups.push(Seen {
+                near: key,
+                everywhere,
+                boxes: group,
+                first_rect: whole_rects.len(),
+            });
             for face in 0..6 {
                 let cells = if everywhere {
                     Some([0, SIDE as u8 - 1, 0, SIDE as u8 - 1])
                 } else {
-                    face_rect(&b, face)
+                    face_rect(&whole, face)
                 };
                 if let Some(cells) = cells {
-                    rects.push(Rect {
-                        shape,
+                    whole_rects.push(Rect {
+                        shape: group[0].0,
+                        near: key,
                         face: face as u8,
                         cells,
                     });
                 }
             }
         }
-        let counts = cell_counts(&rects);
         // Mostly long lists would cost every shadow ray a look-up that
         // sends it to the accelerator anyway (a terrain, or gears, seen
         // from above): decided before any list is filled.
+        let counts = cell_counts(&whole_rects);
         let occupied = counts.iter().filter(|&&c| c > 0).count();
         let long_cells = counts.iter().filter(|&&c| c as usize > MAX_LIST).count();
         if 10 * long_cells > 9 * occupied {
             return None;
         }
+        // Nearest the light first, ties by shape (groups come in shape
+        // order): each cell's list comes out sorted, and a long cell's
+        // first shape left out gives the nearness it is whole within. A
+        // key is never negative, so its bits sort as its value.
+        let mut order: Vec<u64> = groups
+            .iter()
+            .enumerate()
+            .map(|(g, seen)| u64::from(seen.near.to_bits()) << 32 | g as u64)
+            .collect();
+        order.sort_unstable();
+        // Then each shape's own outline, within its whole box's
+        // rectangles: a triangle's rows, a cone's pieces.
+        let mut rects: Vec<Rect> = Vec::with_capacity(whole_rects.len());
+        let (mut near_boxes, mut pieces) = (Vec::new(), Vec::new());
+        for &o in &order {
+            let g = o as u32 as usize;
+            let (everywhere, group) = (groups[g].everywhere, groups[g].boxes);
+            let last = groups
+                .get(g + 1)
+                .map_or(whole_rects.len(), |next| next.first_rect);
+            let whole = &whole_rects[groups[g].first_rect..last];
+            let shape = &scene[group[0].0 as usize];
+            if everywhere || !(group.len() > 1 || matches!(shape, Shape::Triangle(_))) {
+                rects.extend_from_slice(whole);
+                continue;
+            }
+            if !matches!(shape, Shape::Triangle(_)) {
+                near_boxes.clear();
+                near_boxes.extend(
+                    group
+                        .iter()
+                        .map(|&(_, b)| Aabb::new(b.min - pad - light, b.max + pad - light)),
+                );
+            }
+            for &outline in whole {
+                let (face, cells) = (outline.face, outline.cells);
+                let mut push = |cells| rects.push(Rect { cells, ..outline });
+                if let Shape::Triangle(triangle) = shape {
+                    let corners = triangle.vertices.map(|c| c - light);
+                    if !triangle_rows(&corners, face as usize, pad, cells, &mut push) {
+                        push(cells);
+                    }
+                } else {
+                    pieces.clear();
+                    pieces.extend(
+                        near_boxes
+                            .iter()
+                            .filter_map(|b| face_rect(b, face as usize)),
+                    );
+                    merge_rows(&pieces, &mut push);
+                }
+            }
+        }
+        let counts = cell_counts(&rects);
         let mut starts = Vec::with_capacity(CUBE_CELLS + 1);
         let mut next = 0u32;
         for &c in &counts {
             if c as usize > MAX_LIST {
                 starts.push(next | LONG);
+                next += MAX_LIST as u32 + 1;
             } else {
                 starts.push(next);
                 next += c;
             }
         }
         starts.push(next);
+        // `rects` come in the order of `order`: every list sorted.
         let mut shapes = vec![0u32; next as usize];
+        let mut nears = vec![0f32; next as usize];
         let mut filled = vec![0u8; CUBE_CELLS];
         for r in &rects {
             let [i0, i1, j0, j1] = r.cells.map(usize::from);
             let face = r.face as usize * FACE_CELLS;
             for j in j0..=j1 {
                 for cell in face + j * SIDE + i0..=face + j * SIDE + i1 {
-                    let start = starts[cell];
-                    if start & LONG == 0 {
-                        shapes[(start + filled[cell] as u32) as usize] = r.shape;
-                        filled[cell] += 1;
+                    let (start, n) = (starts[cell], filled[cell] as usize);
+                    if start & LONG != 0 && n > MAX_LIST {
+                        continue;
                     }
+                    let at = (start & !LONG) as usize + n;
+                    // A long cell's last entry only marks the nearness.
+                    shapes[at] = r.shape;
+                    nears[at] = r.near;
+                    filled[cell] += 1;
                 }
             }
         }
-        Some(Self { starts, shapes })
+        Some(Self {
+            starts,
+            shapes,
+            nears,
+        })
+    }
+}
+
+/// `distance` rounded down to an `f32` no less than zero, so that a shape
+/// is never ruled out for a ray it could meet.
+fn reach_key(distance: f64) -> f32 {
+    if !(distance > 0.0) {
+        return 0.0;
+    }
+    let key = distance as f32;
+    if f64::from(key) > distance {
+        key.next_down()
+    } else {
+        key
     }
 }
 
@@ -323,51 +477,6 @@ fn cell_of_ray(ray: &PreparedRay) -> usize {
 fn cell_index(u: f64) -> usize {
     // A NaN (a zero direction) lands in cell 0: `as` saturates.
     (((u + 1.0) * 0.5 * SIDE as f64) as usize).min(SIDE - 1)
-}
-
-/// The cells of `face` that box `b` (relative to the light) can be seen
-/// through, as inclusive ranges `[i0, i1, j0, j1]`, or `None`.
-fn face_rect(b: &Aabb, face: usize) -> Option<[u8; 4]> {
-    let major = face / 2;
-    let (across_u, across_v) = ((major + 1) % 3, (major + 2) % 3);
-    // Distances along the face's axis (positive in front of the light).
-    let (m0, m1) = if face.is_multiple_of(2) {
-        (b.min[major], b.max[major])
-    } else {
-        (-b.max[major], -b.min[major])
-    };
-    if m1 <= 0.0 {
-        return None;
-    }
-    // A direction in this face's region has |u|, |v| <= m: the box's
-    // points nearer the light's plane than their distance off the axis
-    // lie in other faces' regions.
-    let off_axis = |axis: usize| b.min[axis].max(-b.max[axis]).max(0.0);
-    let m0 = m0.max(off_axis(across_u)).max(off_axis(across_v));
-    if m0 > m1 {
-        return None;
-    }
-    let range = |axis: usize| -> (f64, f64) {
-        if m0 <= 0.0 {
-            // The box reaches the light's plane: directions up to the
-            // face's edges.
-            return (-1.0, 1.0);
-        }
-        // x / m over the box is monotone in each, so its extremes are at
-        // the corners.
-        let (lo, hi) = (b.min[axis], b.max[axis]);
-        let corners = [lo / m0, lo / m1, hi / m0, hi / m1];
-        let min = corners.iter().copied().fold(f64::INFINITY, f64::min);
-        let max = corners.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        (min - FACE_PAD, max + FACE_PAD)
-    };
-    let (u0, u1) = range(across_u);
-    let (v0, v1) = range(across_v);
-    if u0 > 1.0 || u1 < -1.0 || v0 > 1.0 || v1 < -1.0 {
-        return None;
-    }
-    let cell = |u: f64| cell_index(u.clamp(-1.0, 1.0)) as u8;
-    Some([cell(u0), cell(u1), cell(v0), cell(v1)])
 }
 
 #[cfg(test)]

@@ -217,11 +217,41 @@ impl Cone {
     }
 
     pub fn bounds(&self) -> Aabb {
+        self.pieces(1).next().unwrap_or(Aabb::EMPTY)
+    }
+
+    /// Boxes that together hold the surface: pieces about as long as the
+    /// cone is wide (at most eight), for the light buffer, which lists a
+    /// shape in every direction one of its boxes is seen in.
+    pub fn cover(&self) -> impl Iterator<Item = Aabb> + '_ {
+        let width = 2.0 * self.base_radius.max(self.apex_radius);
+        let count = (self.height / width).ceil();
+        // NaN (a zero radius) and infinity saturate: at most eight.
+        self.pieces((count as usize).clamp(1, 8))
+    }
+
+    /// Boxes of the surface cut into `count` equal lengths along the
+    /// axis (at least one): each piece lies in the convex hull of its two
+    /// end circles, so in the union of their boxes. A slanted cylinder's
+    /// pieces cover far less than its one box.
+    pub fn pieces(&self, count: usize) -> impl Iterator<Item = Aabb> + '_ {
         // A disk of radius r with unit normal a extends r sqrt(1 - a_k^2) along axis k.
         let spread = (DVec3::ONE - self.axis * self.axis).max(DVec3::ZERO);
         let extent = DVec3::new(spread.x.sqrt(), spread.y.sqrt(), spread.z.sqrt());
-        let (eb, ea) = (extent * self.base_radius, extent * self.apex_radius);
-        Aabb::new(self.base - eb, self.base + eb).union(Aabb::new(self.apex - ea, self.apex + ea))
+        let count = count.max(1);
+        let circle = move |k: usize| {
+            if k == count {
+                return (self.apex, self.apex_radius);
+            }
+            let f = k as f64 / count as f64;
+            let r = self.base_radius + f * (self.apex_radius - self.base_radius);
+            (self.base + f * (self.apex - self.base), r)
+        };
+        (0..count).map(move |k| {
+            let ((c0, r0), (c1, r1)) = (circle(k), circle(k + 1));
+            let (e0, e1) = (extent * r0, extent * r1);
+            Aabb::new(c0 - e0, c0 + e0).union(Aabb::new(c1 - e1, c1 + e1))
+        })
     }
 }
 

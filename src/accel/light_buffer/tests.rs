@@ -1,5 +1,6 @@
 //! The light buffer against brute force on scenes made to break it.
 
+use super::projection::triangle_rows;
 use super::*;
 use crate::accel::{Primitives, ShadowCrossings, occlusion_among, occlusion_brute_force};
 use crate::math::Ray;
@@ -115,7 +116,10 @@ fn triangle(a: DVec3, b: DVec3, c: DVec3) -> Shape {
 
 /// Spheres on a grid with lights among them, thin triangles across the
 /// planes through each light, a triangle through a light, a sphere whose
-/// surface holds a light, and a floor.
+/// surface holds a light, slanted cylinders and cones (listed by pieces),
+/// one through a light, a row of spheres seen end on from a light (long
+/// cells), a polygon cut into a fan of slivers under a light and slivers
+/// pointing every way round a light (projected row by row), and a floor.
 fn adversarial(scale: f64, offset: DVec3) -> (Vec<Shape>, Vec<DVec3>) {
     let p = |x: f64, y: f64, z: f64| offset + scale * DVec3::new(x, y, z);
     let mut shapes = crate::accel::sphere_grid(4, 0.3)
@@ -156,6 +160,42 @@ fn adversarial(scale: f64, offset: DVec3) -> (Vec<Shape>, Vec<DVec3>) {
     // A tiny sphere next to the first light, inside its near zone's reach
     // only at the smallest scales.
     shapes.push(sphere(p(1.5 + 1e-7, 1.5, 1.5), 1e-8 * scale));
+    // Slanted thin cylinders and cones round the first light, one a
+    // cone to a point, one along the axis the second light is on, one
+    // through the first light.
+    for k in 0..8 {
+        let a = k as f64 * std::f64::consts::FRAC_PI_4;
+        let (c, s) = (a.cos(), a.sin());
+        let (base, apex) = (p(1.5 + c, 1.5 + s, 1.0), p(1.5 - s, 1.5 + c, 2.2));
+        let apex_radius = if k % 3 == 0 { 0.0 } else { 0.04 * scale };
+        let cone = crate::shapes::Cone::new(base, 0.05 * scale, apex, apex_radius);
+        shapes.push(Shape::Cone(Box::new(cone.expect("a cone"))));
+    }
+    for (base, apex) in [
+        (p(0.0, 0.0, 2.0), p(0.0, 0.0, 4.5)),
+        (p(1.0, 1.0, 1.5), p(2.0, 2.0, 1.5)),
+    ] {
+        let cone = crate::shapes::Cone::new(base, 0.03 * scale, apex, 0.03 * scale);
+        shapes.push(Shape::Cone(Box::new(cone.expect("a cylinder"))));
+    }
+    for k in 0..16 {
+        shapes.push(sphere(p(3.0, 0.5, 0.8 + 0.1 * k as f64), 0.03 * scale));
+    }
+    let corner = |k: usize| {
+        let a = k as f64 * std::f64::consts::TAU / 30.0;
+        p(1.5 * a.cos(), 1.5 * a.sin(), 3.0)
+    };
+    for k in 1..29 {
+        shapes.push(triangle(corner(0), corner(k), corner(k + 1)));
+    }
+    let mut uniform = Uniform(17);
+    for _ in 0..40 {
+        let mut towards = || DVec3::new(uniform.next(), uniform.next(), uniform.next()) - 0.5;
+        let (d, e) = (towards().normalize(), 0.02 * towards());
+        let (near, far) = (0.05 + uniform.next(), 0.5 + 2.0 * uniform.next());
+        let at = |t: f64| p(1.5, 1.5, 1.5) + scale * t * d;
+        shapes.push(triangle(at(near), at(far), at(far) + scale * e));
+    }
     shapes.push(Shape::Plane(Plane::new(p(0.0, -1.0, 0.0), DVec3::Y)));
     (shapes, lights)
 }
@@ -235,8 +275,23 @@ fn crowded_cells_go_to_the_accelerator() {
         .map(|i| sphere(DVec3::new(2.0 + i as f64, 0.0, 0.0), 0.4))
         .collect();
     let beyond = LightBuffer::build(&shapes, &[DVec3::ZERO]).unwrap();
+    let from = |x: f64| PreparedRay::new(Ray::new(DVec3::new(x, 0.0, 0.0), DVec3::NEG_X));
     assert!(matches!(
-        beyond.candidates(0, &along(DVec3::NEG_X)),
+        beyond.candidates(0, &from(30.0)),
+        Candidates::Many
+    ));
+    // A ray from x meets at most the spheres that come nearer the light
+    // (sphere i from 1.6 + i): up to the twelfth (to 13.4), those are
+    // listed; past the thirteenth's start (13.6) the cell has too many.
+    for (x, nearer) in [(0.5, 0), (1.0, 0), (1.7, 1), (8.0, 7), (13.5, 12)] {
+        let expected: Vec<u32> = (0..nearer).collect();
+        match beyond.candidates(0, &from(x)) {
+            Candidates::Few(list) => assert_eq!(list, expected, "from x = {x}"),
+            Candidates::Many => panic!("from x = {x}: the nearest twelve suffice"),
+        }
+    }
+    assert!(matches!(
+        beyond.candidates(0, &from(13.7)),
         Candidates::Many
     ));
     assert!(matches!(
@@ -283,6 +338,7 @@ fn counts_by_difference_table_match_counting_cell_by_cell() {
             }
             Rect {
                 shape: k,
+                near: 0.0,
                 face: (k % 6) as u8,
                 cells: c,
             }
@@ -334,4 +390,66 @@ fn a_rays_cell_from_its_shear_is_the_cell_of_its_reversed_direction() {
     for d in dirs {
         assert_eq!(cell_of_ray(&along(d)), cell_of(-d), "direction {d:?}");
     }
+}
+
+#[test]
+fn a_triangles_rows_hold_every_point_near_it() {
+    // Points within the padding of triangles near and far, in every
+    // direction from the light (at the origin), fall in cells the rows
+    // list, for the face their direction belongs to.
+    let pad = 1e-3;
+    let mut uniform = Uniform(5);
+    let mut covered = vec![false; CUBE_CELLS];
+    let mut by_rows = 0;
+    for n in 0..400 {
+        let distance = [0.02, 0.1, 1.0, 30.0][n % 4];
+        let centre = (DVec3::new(uniform.next(), uniform.next(), uniform.next()) - 0.5).normalize()
+            * distance;
+        let size = distance * [0.05, 0.5, 2.0][n % 3];
+        let mut corner =
+            || centre + size * (DVec3::new(uniform.next(), uniform.next(), uniform.next()) - 0.5);
+        let v = [corner(), corner(), corner()];
+        let b = Aabb::from_points(&v);
+        let b = Aabb::new(b.min - pad, b.max + pad);
+        covered.fill(false);
+        for face in 0..6 {
+            let Some(bound) = face_rect(&b, face) else {
+                continue;
+            };
+            let mut mark = |[i0, i1, j0, j1]: [u8; 4]| {
+                for j in j0..=j1 {
+                    for i in i0..=i1 {
+                        covered[face * FACE_CELLS + j as usize * SIDE + i as usize] = true;
+                    }
+                }
+            };
+            if triangle_rows(&v, face, pad, bound, &mut mark) {
+                by_rows += 1;
+            } else {
+                mark(bound);
+            }
+        }
+        for _ in 0..200 {
+            let (s, t) = (uniform.next(), uniform.next());
+            let (s, t) = if s + t > 1.0 {
+                (1.0 - s, 1.0 - t)
+            } else {
+                (s, t)
+            };
+            let off =
+                pad * (2.0 * DVec3::new(uniform.next(), uniform.next(), uniform.next()) - 1.0);
+            // On the edges too: a third of the points.
+            let (s, t) = if uniform.next() < 0.33 {
+                (s, 0.0)
+            } else {
+                (s, t)
+            };
+            let point = v[0] + s * (v[1] - v[0]) + t * (v[2] - v[0]) + off;
+            assert!(
+                covered[cell_of(point)],
+                "triangle {n} {v:?}: point {point:?} in no listed cell"
+            );
+        }
+    }
+    assert!(by_rows > 300, "most triangles projected by rows: {by_rows}");
 }
