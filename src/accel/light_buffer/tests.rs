@@ -269,31 +269,39 @@ fn rays_along_the_cube_edges_and_axes_answer_as_brute_force() {
 
 #[test]
 fn crowded_cells_go_to_the_accelerator() {
-    // Forty spheres in a row seen end on from the light: their cells list
-    // too many, and so do the cells of a light inside all their boxes.
-    let shapes: Vec<Shape> = (0..40)
+    // More spheres in a row, seen end on from the light, than a cell
+    // keeps: their cells are long, and so are those of a light inside
+    // all their boxes.
+    let count = MAX_LIST + 20;
+    let shapes: Vec<Shape> = (0..count)
         .map(|i| sphere(DVec3::new(2.0 + i as f64, 0.0, 0.0), 0.4))
         .collect();
     let beyond = LightBuffer::build(&shapes, &[DVec3::ZERO]).unwrap();
     let from = |x: f64| PreparedRay::new(Ray::new(DVec3::new(x, 0.0, 0.0), DVec3::NEG_X));
-    assert!(matches!(
-        beyond.candidates(0, &from(30.0)),
-        Candidates::Many
-    ));
     // A ray from x meets at most the spheres that come nearer the light
-    // (sphere i from 1.6 + i): up to the twelfth (to 13.4), those are
-    // listed; past the thirteenth's start (13.6) the cell has too many.
-    for (x, nearer) in [(0.5, 0), (1.0, 0), (1.7, 1), (8.0, 7), (13.5, 12)] {
+    // (sphere i from 1.6 + i): up to the last one kept (to MAX_LIST +
+    // 1.4), those are listed; from the next one's start (MAX_LIST + 1.6)
+    // on, the cell has too many.
+    let kept = MAX_LIST as f64;
+    for (x, nearer) in [
+        (0.5, 0),
+        (1.0, 0),
+        (1.7, 1),
+        (8.0, 7),
+        (kept + 1.5, MAX_LIST as u32),
+    ] {
         let expected: Vec<u32> = (0..nearer).collect();
         match beyond.candidates(0, &from(x)) {
             Candidates::Few(list) => assert_eq!(list, expected, "from x = {x}"),
-            Candidates::Many => panic!("from x = {x}: the nearest twelve suffice"),
+            Candidates::Many => panic!("from x = {x}: the nearest suffice"),
         }
     }
-    assert!(matches!(
-        beyond.candidates(0, &from(13.7)),
-        Candidates::Many
-    ));
+    for x in [kept + 1.7, kept + 10.0, 2.0 * count as f64] {
+        assert!(
+            matches!(beyond.candidates(0, &from(x)), Candidates::Many),
+            "from x = {x}"
+        );
+    }
     assert!(matches!(
         beyond.candidates(0, &along(DVec3::X)),
         Candidates::Few([])
