@@ -15,7 +15,7 @@ mod projection;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use self::projection::{face_rect, merge_rows, triangle_rows};
+use self::projection::{face_rect, merge_rows, nearest_distance, triangle_rows};
 use crate::math::{Aabb, DVec3};
 use crate::shapes::{PreparedRay, Shape};
 
@@ -267,6 +267,15 @@ impl DirectionCube {
                 everywhere |= gap <= near || !(b.min.is_finite() && b.max.is_finite());
                 key = key.min(reach_key(gap - pad));
                 whole = whole.union(b);
+            }
+            // A triangle comes no nearer than its nearest point, often
+            // farther than its box's corner (for one whose angles are all
+            // far from 0 and 180 degrees: the closest point's rounding then
+            // stays far below the padding).
+            if let Shape::Triangle(triangle) = &scene[group[0].0 as usize]
+                && let Some(distance) = nearest_distance(&triangle.vertices.map(|c| c - light))
+            {
+                key = key.max(reach_key(distance - 2.0 * pad));
             }
             let key = if everywhere { 0.0 } else { key };
             groups.push(Seen {

@@ -78,6 +78,59 @@ pub(super) fn merge_rows(pieces: &[[u8; 4]], push: &mut impl FnMut([u8; 4])) {
 /// triangle, at least `m` in front of the plane, projects at most
 /// `2 pad (1 + |u|) / m` from it: the band and the columns are widened
 /// by that and by [`FACE_PAD`].
+/// The distance from the origin to the triangle `v` (the closest point
+/// by the regions of its corners, edges and face: Ericson, Real-Time
+/// Collision Detection, 5.1.5), or `None` for a sliver (an angle's sine
+/// under 1e-3), whose closest point rounding could move far.
+pub(super) fn nearest_distance(v: &[DVec3; 3]) -> Option<f64> {
+    let [a, b, c] = *v;
+    let (ab, ac, bc) = (b - a, c - a, c - b);
+    let twice_area = ab.cross(ac).length_squared();
+    let longest = ab
+        .length_squared()
+        .max(ac.length_squared())
+        .max(bc.length_squared());
+    // The smallest angle's sine is twice the area over the product of
+    // the two longest sides, at least over the longest side squared.
+    if !(twice_area >= 1e-6 * longest * longest) {
+        return None;
+    }
+    Some(closest_point(a, b, c).length())
+}
+
+/// The triangle's point nearest the origin.
+fn closest_point(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
+    let (ab, ac, ap) = (b - a, c - a, -a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a;
+    }
+    let bp = -b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return a + d1 / (d1 - d3) * ab;
+    }
+    let cp = -c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return a + d2 / (d2 - d6) * ac;
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 {
+        return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
+    }
+    let denominator = 1.0 / (va + vb + vc);
+    a + vb * denominator * ab + vc * denominator * ac
+}
+
 pub(super) fn triangle_rows<F: FnMut([u8; 4])>(
     v: &[DVec3; 3],
     face: usize,

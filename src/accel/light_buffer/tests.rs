@@ -461,3 +461,53 @@ fn a_triangles_rows_hold_every_point_near_it() {
     }
     assert!(by_rows > 300, "most triangles projected by rows: {by_rows}");
 }
+
+#[test]
+fn a_triangles_nearest_distance_is_no_more_than_any_of_its_points() {
+    // Against the distances of points spread over triangles of every
+    // shape, slivers included, the light inside, beside and far off;
+    // and exact where the answer is known.
+    use super::projection::nearest_distance;
+    let mut uniform = Uniform(11);
+    let mut measured = 0;
+    for n in 0..3_000 {
+        let spread = [0.01, 1.0, 100.0][n % 3];
+        let mut corner =
+            || spread * (DVec3::new(uniform.next(), uniform.next(), uniform.next()) - 0.3);
+        let (a, b) = (corner(), corner());
+        // Every fourth a sliver: the third corner near the first edge.
+        let c = if n % 4 == 0 {
+            a + uniform.next() * (b - a) + 1e-3 * spread * uniform.next() * DVec3::Z
+        } else {
+            corner()
+        };
+        let Some(d) = nearest_distance(&[a, b, c]) else {
+            continue;
+        };
+        measured += 1;
+        let mut closest = f64::INFINITY;
+        for i in 0..=40 {
+            for j in 0..=40 - i {
+                let (s, t) = (i as f64 / 40.0, j as f64 / 40.0);
+                closest = closest.min((a + s * (b - a) + t * (c - a)).length());
+            }
+        }
+        assert!(
+            d <= closest * (1.0 + 1e-12),
+            "triangle {n}: {d} > {closest}"
+        );
+        assert!(d >= 0.0);
+    }
+    assert!(measured > 2_000, "{measured}");
+    let unit = [
+        DVec3::new(-1.0, -1.0, 2.0),
+        DVec3::new(3.0, -1.0, 2.0),
+        DVec3::new(-1.0, 3.0, 2.0),
+    ];
+    assert_eq!(nearest_distance(&unit), Some(2.0));
+    let aside = unit.map(|p| p + DVec3::new(5.0, 0.0, -2.0));
+    // Nearest on the edge x = 4, at (4, 0, 0).
+    assert!((nearest_distance(&aside).unwrap() - 4.0).abs() < 1e-12);
+    let sliver = [DVec3::ZERO, DVec3::X, DVec3::new(0.5, 1e-9, 0.0)];
+    assert_eq!(nearest_distance(&sliver.map(|p| p + DVec3::Y)), None);
+}
