@@ -222,16 +222,18 @@ impl LightBuffer {
     }
 }
 
-/// One shape as a light sees it.
-struct Seen<'b> {
+/// One shape as a light sees it (16 bytes: one per shape and cube being
+/// built).
+struct Seen {
     /// How near its boxes come (see [`Rect::near`]); 0 if `everywhere`.
     near: f32,
+    /// Where its boxes start in the builder's list of boxes, and its whole
+    /// box's rectangles in `whole_rects`.
+    first_box: u32,
+    first_rect: u32,
     /// So near the light (or so far out of range) that every direction
     /// may meet it.
     everywhere: bool,
-    boxes: &'b [(u32, Aabb)],
-    /// Where its whole box's rectangles start.
-    first_rect: usize,
 }
 
 /// The cells of one face a box can be seen through, as inclusive ranges.
@@ -258,6 +260,7 @@ impl DirectionCube {
         // Whole boxes' rectangles first: cheap, and enough to tell a cube
         // of mostly long lists, which is not kept.
         let mut whole_rects: Vec<Rect> = Vec::new();
+        let mut first_box = 0;
         for group in boxes.chunk_by(|a, b| a.0 == b.0) {
             let (mut key, mut everywhere, mut whole) = (f32::INFINITY, false, Aabb::EMPTY);
             for &(_, b) in group {
@@ -280,10 +283,11 @@ impl DirectionCube {
             let key = if everywhere { 0.0 } else { key };
             groups.push(Seen {
                 near: key,
+                first_box,
+                first_rect: whole_rects.len() as u32,
                 everywhere,
-                boxes: group,
-                first_rect: whole_rects.len(),
             });
+            first_box += group.len() as u32;
             for face in 0..6 {
                 let cells = if everywhere {
                     Some([0, SIDE as u8 - 1, 0, SIDE as u8 - 1])
@@ -325,11 +329,12 @@ impl DirectionCube {
         let (mut near_boxes, mut pieces) = (Vec::new(), Vec::new());
         for &o in &order {
             let g = o as u32 as usize;
-            let (everywhere, group) = (groups[g].everywhere, groups[g].boxes);
-            let last = groups
-                .get(g + 1)
-                .map_or(whole_rects.len(), |next| next.first_rect);
-            let whole = &whole_rects[groups[g].first_rect..last];
+            let (seen, next) = (&groups[g], groups.get(g + 1));
+            let everywhere = seen.everywhere;
+            let group =
+                &boxes[seen.first_box as usize..next.map_or(boxes.len(), |n| n.first_box as usize)];
+            let whole = &whole_rects[seen.first_rect as usize
+                ..next.map_or(whole_rects.len(), |n| n.first_rect as usize)];
             let shape = &scene[group[0].0 as usize];
             if everywhere || !(group.len() > 1 || matches!(shape, Shape::Triangle(_))) {
                 rects.extend_from_slice(whole);
