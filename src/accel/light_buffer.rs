@@ -61,7 +61,7 @@ const MAX_CUBES: usize = 16;
 const LONG: u32 = 1 << 31;
 
 /// One light's cube of directions. Every list is sorted by how near its
-/// shapes' boxes come to the light, and a shadow ray tests only those
+/// shapes (their boxes, or a triangle itself) come to the light, and a shadow ray tests only those
 /// nearer the light than its origin (no point of the ray is farther). A
 /// long cell keeps its `MAX_LIST` nearest, then the nearness of the first
 /// one left out: a shadow ray that starts nearer (a point lit through a
@@ -256,6 +256,8 @@ impl DirectionCube {
         pad: f64,
         near: f64,
     ) -> Option<Self> {
+        // A box relative to the light, padded.
+        let seen_box = |b: Aabb| Aabb::new(b.min - pad - light, b.max + pad - light);
         let mut groups: Vec<Seen> = Vec::new();
         // Whole boxes' rectangles first: cheap, and enough to tell a cube
         // of mostly long lists, which is not kept.
@@ -264,7 +266,7 @@ impl DirectionCube {
         for group in boxes.chunk_by(|a, b| a.0 == b.0) {
             let (mut key, mut everywhere, mut whole) = (f32::INFINITY, false, Aabb::EMPTY);
             for &(_, b) in group {
-                let b = Aabb::new(b.min - pad - light, b.max + pad - light);
+                let b = seen_box(b);
                 let gap = (b.min.max(DVec3::ZERO) + (-b.max).max(DVec3::ZERO)).length();
                 // A box beyond f64's range projects to no number: every cell.
                 everywhere |= gap <= near || !(b.min.is_finite() && b.max.is_finite());
@@ -335,23 +337,23 @@ impl DirectionCube {
                 &boxes[seen.first_box as usize..next.map_or(boxes.len(), |n| n.first_box as usize)];
             let whole = &whole_rects[seen.first_rect as usize
                 ..next.map_or(whole_rects.len(), |n| n.first_rect as usize)];
-            let shape = &scene[group[0].0 as usize];
-            if everywhere || !(group.len() > 1 || matches!(shape, Shape::Triangle(_))) {
+            let triangle = match &scene[group[0].0 as usize] {
+                Shape::Triangle(t) => Some(t),
+                _ => None,
+            };
+            // One box of another shape: its rectangles are its outline.
+            if everywhere || (triangle.is_none() && group.len() == 1) {
                 rects.extend_from_slice(whole);
                 continue;
             }
-            if !matches!(shape, Shape::Triangle(_)) {
+            if triangle.is_none() {
                 near_boxes.clear();
-                near_boxes.extend(
-                    group
-                        .iter()
-                        .map(|&(_, b)| Aabb::new(b.min - pad - light, b.max + pad - light)),
-                );
+                near_boxes.extend(group.iter().map(|&(_, b)| seen_box(b)));
             }
             for &outline in whole {
                 let (face, cells) = (outline.face, outline.cells);
                 let mut push = |cells| rects.push(Rect { cells, ..outline });
-                if let Shape::Triangle(triangle) = shape {
+                if let Some(triangle) = triangle {
                     let corners = triangle.vertices.map(|c| c - light);
                     if !triangle_rows(&corners, face as usize, pad, cells, &mut push) {
                         push(cells);

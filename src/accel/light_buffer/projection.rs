@@ -65,19 +65,6 @@ pub(super) fn merge_rows(pieces: &[[u8; 4]], push: &mut impl FnMut([u8; 4])) {
     runs.finish();
 }
 
-/// The rows of `face` through which the triangle `v` (relative to the
-/// light, each point padded by `pad` in space by the caller's box) can be
-/// seen, within `bound` (the rectangle of its padded box), or `false` if
-/// it does not lie wholly in front of the face's plane (a vertex behind
-/// it, or nearer than twice the padding), for which the box is used.
-///
-/// In front of the plane, the triangle projects to the triangle of its
-/// projected vertices; row by row, the columns it covers run from its
-/// leftmost to its rightmost point in the row's band, which lie at
-/// vertices or where edges cross the band's edges. A point `pad` off the
-/// triangle, at least `m` in front of the plane, projects at most
-/// `2 pad (1 + |u|) / m` from it: the band and the columns are widened
-/// by that and by [`FACE_PAD`].
 /// The distance from the origin to the triangle `v` (the closest point
 /// by the regions of its corners, edges and face: Ericson, Real-Time
 /// Collision Detection, 5.1.5), or `None` for a sliver (an angle's sine
@@ -131,6 +118,19 @@ fn closest_point(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
     a + vb * denominator * ab + vc * denominator * ac
 }
 
+/// The rows of `face` through which the triangle `v` (relative to the
+/// light, each point padded by `pad` in space by the caller's box) can be
+/// seen, within `bound` (the rectangle of its padded box), or `false` if
+/// it does not lie wholly in front of the face's plane (a vertex behind
+/// it, or nearer than twice the padding), for which the box is used.
+///
+/// In front of the plane, the triangle projects to the triangle of its
+/// projected vertices; row by row, the columns it covers run from its
+/// leftmost to its rightmost point in the row's band, which lie at
+/// vertices or where edges cross the band's edges. A point `pad` off the
+/// triangle, at least `m` in front of the plane, projects at most
+/// `2 pad (1 + |u|) / m` from it: the band and the columns are widened
+/// by that and by [`FACE_PAD`].
 pub(super) fn triangle_rows<F: FnMut([u8; 4])>(
     v: &[DVec3; 3],
     face: usize,
