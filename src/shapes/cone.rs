@@ -6,6 +6,11 @@ use crate::math::{Aabb, DVec3, Ray, solve_quadratic_half};
 
 /// Relative margin of the early miss test in `Cone::roots`.
 const MISS_MARGIN: f64 = 1e-9;
+/// Relative margin of the line-to-line miss test: ten times
+/// `MISS_MARGIN`, enough that whatever it rules out the segment test
+/// (whose margin grows with the re-based origin, at most `sqrt 3` times
+/// the gap plus the height) would have ruled out too.
+const LINE_MARGIN: f64 = 1e-8;
 
 /// Open truncated cone (or cylinder) between two disks, without end caps:
 /// NFF's `c` primitive. The radius varies linearly from `base_radius` at
@@ -20,6 +25,9 @@ pub struct Cone {
     axis: DVec3,
     height: f64,
     slope: f64,
+    /// What `line_passes_wide` needs whatever the ray: the widest radius
+    /// and height with their margins.
+    line_reach: f64,
 }
 
 impl Cone {
@@ -43,6 +51,7 @@ impl Cone {
             axis: span / height,
             height,
             slope: (apex_radius - base_radius) / height,
+            line_reach: base_radius.max(apex_radius) * (1.0 + LINE_MARGIN) + LINE_MARGIN * height,
         })
     }
 
@@ -60,6 +69,16 @@ impl Cone {
     /// segment's middle: a cone can be far longer than the ray is long.
     #[inline(always)]
     fn roots(&self, ray: &Ray) -> Option<((f64, f64), impl Fn(f64) -> bool)> {
+        if self.line_passes_wide(ray) {
+            return None;
+        }
+        self.roots_near_segment(ray)
+    }
+
+    /// `roots` without the line-to-line miss test, which must never rule
+    /// out what this finds.
+    #[inline(always)]
+    fn roots_near_segment(&self, ray: &Ray) -> Option<((f64, f64), impl Fn(f64) -> bool)> {
         let (shift, along) = self.nearest_to_axis(ray);
         let o = (ray.origin + shift * ray.dir) - self.base;
         // A line that passes the axis segment farther off than the widest
@@ -91,6 +110,21 @@ impl Cone {
             z >= 0.0 && z <= height && base_radius + slope * z >= 0.0
         };
         Some(((t0 + shift, t1 + shift), on_part))
+    }
+
+    /// Whether the ray's line passes the axis's whole line farther off than
+    /// the widest radius, by a margin that keeps `roots`' own miss test
+    /// (on the nearer segment) bound to agree: the distance between the
+    /// two lines, `|w . n| / |n|` with `n = dir x axis`, costs no division
+    /// where the segment's needs two. Lines within a milliradian of
+    /// parallel are left to that test, as `n` loses its relative accuracy.
+    #[inline(always)]
+    fn line_passes_wide(&self, ray: &Ray) -> bool {
+        let w = ray.origin - self.base;
+        let n = ray.dir.cross(self.axis);
+        let (across, n2) = (w.dot(n), n.length_squared());
+        let far = self.line_reach + LINE_MARGIN * w.abs().element_sum();
+        across * across > far * far * n2 && n2 > 1e-6 * ray.dir.length_squared()
     }
 
     /// The parameter of the ray's point nearest the axis segment (closest
@@ -288,6 +322,66 @@ mod tests {
             assert!(b.contains(tilted.base + 0.5 * rim) && b.contains(tilted.apex + 0.2 * rim));
         }
         assert!(Cone::new(DVec3::ONE, 1.0, DVec3::ONE, 1.0).is_none());
+    }
+
+    /// The line-to-line test only rules out lines the segment's own test
+    /// would: for random cones (slanted, pointed, far from the origin, tiny
+    /// and huge) and lines passing them at every distance, from near and
+    /// far, a line it rules out never has roots near the segment. And it
+    /// does rule most far lines out, or it would save nothing.
+    #[test]
+    fn the_line_test_rules_out_only_what_the_segment_test_does() {
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut unit = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut ruled_out, mut far_lines) = (0, 0);
+        for case in 0..20_000 {
+            let scale = [1e-4, 1.0, 1e4][case % 3];
+            let offset = [0.0, 1e6, -3e3][case % 5 % 3] * scale;
+            let mut point = || DVec3::new(unit() - 0.5, unit() - 0.5, unit() - 0.5) * 8.0 * scale;
+            let base = point() + DVec3::splat(offset);
+            let apex = base + point();
+            let dir = match case % 11 {
+                // Within a few milliradians of the axis, down to 1e-9.
+                0..=3 => {
+                    (apex - base).normalize() + 10f64.powi(-(case as i32 % 8) - 2) * point() / scale
+                }
+                _ => point() + 1e-3 * scale * (apex - base),
+            }
+            .normalize();
+            let r0 = if case % 4 == 0 { 0.0 } else { unit() * scale };
+            let r1 = (unit() * scale).max(1e-3 * scale);
+            let along = unit() * 1.4 - 0.2;
+            let Some(cone) = Cone::new(base, r0, apex, r1) else {
+                continue;
+            };
+            // A line through a point at a chosen distance from the axis
+            // segment's line, origin near or far back along it.
+            let widest = cone.base_radius.max(cone.apex_radius);
+            let (e1, _) = crate::math::orthonormal_basis(cone.axis);
+            let gap = widest * [0.5, 0.999, 1.001, 1.1, 3.0, 100.0][case % 6];
+            let through = base + along * (apex - base) + gap * e1;
+            let back = [1.0, 10.0, 1e6][case % 7 % 3] * scale;
+            let ray = Ray::new(through - back * dir, dir);
+            if gap > 1.01 * widest {
+                far_lines += 1;
+            }
+            if cone.line_passes_wide(&ray) {
+                ruled_out += 1;
+                assert!(
+                    cone.roots_near_segment(&ray).is_none(),
+                    "case {case}: {cone:?} {ray:?}"
+                );
+            }
+        }
+        assert!(
+            ruled_out > far_lines / 3,
+            "{ruled_out} of {far_lines} ruled out"
+        );
     }
 
     #[test]
