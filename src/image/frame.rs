@@ -227,30 +227,28 @@ impl Frame {
         // (the sRGB encoding of an 800x600 frame is 1.4 million table lookups).
         let near = (self.view == ViewMode::Depth).then(|| nearest_depth(&self.pixels));
         let range = self.cost_summary().map_or((0.0, 0.0), |c| (c.min, c.max));
-        let encode = |p: &DVec3| -> [u8; 3] {
-            match self.view {
-                // Element by element, not `array::map`: its closure was a
-                // call per channel.
-                ViewMode::Shaded => [
-                    self.colors.byte(p.x),
-                    self.colors.byte(p.y),
-                    self.colors.byte(p.z),
-                ],
-                ViewMode::Normals => [p.x, p.y, p.z].map(to_byte),
-                ViewMode::Depth => [to_byte(depth_shade(*p, near.unwrap_or(0.0))); 3],
-                ViewMode::Cost | ViewMode::CostSteps => {
-                    crate::image::legend::viridis(cost_shade(cost_value(*p, self.view), range))
-                }
-                ViewMode::AaNeed => [p.x, p.y, p.z].map(|c| to_byte(c * AA_NEED_GAIN)),
-            }
-        };
+        // The view and colour convention matched once a chunk, not once a
+        // pixel: each arm's loop is compiled for its own encoding.
         let mut out = vec![0u8; self.pixels.len() * 3];
         out.par_chunks_mut(3 * 4096)
             .zip(self.pixels.par_chunks(4096))
-            .for_each(|(bytes, pixels)| {
-                for (b, p) in bytes.chunks_exact_mut(3).zip(pixels) {
-                    b.copy_from_slice(&encode(p));
+            .for_each(|(bytes, pixels)| match (self.view, self.colors) {
+                (ViewMode::Shaded, ColorConvention::Linear) => {
+                    encode_channels(bytes, pixels, |c| ColorConvention::Linear.byte(c))
                 }
+                (ViewMode::Shaded, ColorConvention::Display) => {
+                    encode_channels(bytes, pixels, to_byte)
+                }
+                (ViewMode::Normals, _) => encode_channels(bytes, pixels, to_byte),
+                (ViewMode::AaNeed, _) => {
+                    encode_channels(bytes, pixels, |c| to_byte(c * AA_NEED_GAIN))
+                }
+                (ViewMode::Depth, _) => encode_pixels(bytes, pixels, |p| {
+                    [to_byte(depth_shade(p, near.unwrap_or(0.0))); 3]
+                }),
+                (ViewMode::Cost | ViewMode::CostSteps, _) => encode_pixels(bytes, pixels, |p| {
+                    crate::image::legend::viridis(cost_shade(cost_value(p, self.view), range))
+                }),
             });
         out
     }
@@ -381,6 +379,20 @@ pub fn resample_rgba(rgba: &[u8], from_w: u32, from_h: u32, w: u32, h: u32) -> V
         }
     }
     out
+}
+
+/// Each pixel as three bytes by `encode`, the loop inlined for it.
+#[inline(always)]
+fn encode_pixels(bytes: &mut [u8], pixels: &[DVec3], encode: impl Fn(DVec3) -> [u8; 3]) {
+    for (b, p) in bytes.chunks_exact_mut(3).zip(pixels) {
+        b.copy_from_slice(&encode(*p));
+    }
+}
+
+/// Each channel of each pixel as a byte by `byte`.
+#[inline(always)]
+fn encode_channels(bytes: &mut [u8], pixels: &[DVec3], byte: impl Fn(f64) -> u8) {
+    encode_pixels(bytes, pixels, |p| [byte(p.x), byte(p.y), byte(p.z)]);
 }
 
 #[cfg(test)]
