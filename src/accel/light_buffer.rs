@@ -493,8 +493,11 @@ fn cell_of_ray(ray: &PreparedRay) -> usize {
 /// The cell along one side that face coordinate `u` (in `[-1, 1]`) falls in.
 #[inline(always)]
 fn cell_index(u: f64) -> usize {
-    // A NaN (a zero direction) lands in cell 0: `as` saturates.
-    (((u + 1.0) * 0.5 * SIDE as f64) as usize).min(SIDE - 1)
+    // Clamped as a float first (`max` takes a NaN, from a zero direction,
+    // to 0), so the conversion needs no saturating checks of its own.
+    ((u + 1.0) * 0.5 * SIDE as f64)
+        .max(0.0)
+        .min((SIDE - 1) as f64) as u32 as usize
 }
 
 #[cfg(test)]

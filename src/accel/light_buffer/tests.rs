@@ -365,6 +365,34 @@ fn counts_by_difference_table_match_counting_cell_by_cell() {
 }
 
 #[test]
+fn a_face_coordinate_falls_in_the_cell_that_holds_it() {
+    // Cell k holds [k, k + 1) / SIDE of [0, 1] after `(u + 1) / 2`; below
+    // the face (and NaN) is cell 0, its far edge and beyond the last cell.
+    let side = SIDE as f64;
+    for k in 0..SIDE {
+        let low = 2.0 * k as f64 / side - 1.0;
+        let high = 2.0 * (k + 1) as f64 / side - 1.0;
+        // Exact at `low` (SIDE is a power of two); just inside `high` the
+        // arithmetic may round up into the next cell.
+        for u in [low, low + 1e-12, 0.5 * (low + high), high - 1e-12] {
+            assert_eq!(cell_index(u), k, "u = {u}");
+        }
+    }
+    for (u, k) in [
+        (f64::NAN, 0),
+        (f64::NEG_INFINITY, 0),
+        (-1.5, 0),
+        (-1.0, 0),
+        (1.0, SIDE - 1),
+        (1.0f64.next_up(), SIDE - 1),
+        (3e9, SIDE - 1),
+        (f64::INFINITY, SIDE - 1),
+    ] {
+        assert_eq!(cell_index(u), k, "u = {u}");
+    }
+}
+
+#[test]
 fn a_rays_cell_from_its_shear_is_the_cell_of_its_reversed_direction() {
     // Every face and its edges and corners, where the dominant axis is a
     // tie; zero and negative-zero components; random directions; and
