@@ -211,6 +211,21 @@ pub fn orthonormal_basis(n: DVec3) -> (DVec3, DVec3) {
     )
 }
 
+/// A deterministic stream of numbers in `[0, 1)` for tests (Marsaglia's
+/// xorshift, as [`crate::render::random_lines`] draws its lines).
+#[cfg(test)]
+pub(crate) struct XorShift(pub u64);
+
+#[cfg(test)]
+impl XorShift {
+    pub(crate) fn unit(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -4,7 +4,7 @@
 use super::hit::{Crossings, ShapeHit, Surface, unit_or_none};
 use crate::math::{Aabb, DVec3, Ray, solve_quadratic_half};
 
-/// Relative margin of the early miss test in `Cone::roots`.
+/// Relative margin of the early miss test in `Cone::roots_near_segment`.
 const MISS_MARGIN: f64 = 1e-9;
 /// Relative margin of the line-to-line miss test: ten times
 /// `MISS_MARGIN`, enough that whatever it rules out the segment test
@@ -331,13 +331,8 @@ mod tests {
     /// does rule most far lines out, or it would save nothing.
     #[test]
     fn the_line_test_rules_out_only_what_the_segment_test_does() {
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut unit = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut random = crate::math::XorShift(0x2545_f491_4f6c_dd1d);
+        let mut unit = move || random.unit();
         let (mut ruled_out, mut far_lines) = (0, 0);
         for case in 0..20_000 {
             let scale = [1e-4, 1.0, 1e4][case % 3];

@@ -407,15 +407,8 @@ impl Fill<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::{Aabb, DVec3};
-
-    /// A deterministic stream of numbers in `[0, 1)`.
-    fn uniform(seed: &mut u64) -> f64 {
-        *seed ^= *seed << 13;
-        *seed ^= *seed >> 7;
-        *seed ^= *seed << 17;
-        (*seed >> 11) as f64 / (1u64 << 53) as f64
-    }
+    use crate::math::{Aabb, DVec3, Ray, XorShift};
+    use crate::shapes::PreparedRay;
 
     /// Rays that touch a box only at a corner, an edge or a face (and rays
     /// along an axis, which the rounding of the origin must not cut off)
@@ -423,14 +416,12 @@ mod tests {
     /// boxes and rounded origins are conservative where they are tightest.
     #[test]
     fn rays_grazing_a_box_meet_it() {
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut random = XorShift(0x9e37_79b9_7f4a_7c15);
         let corner = DVec3::new(-3.0, 1.5, 7.25);
         for case in 0..20_000 {
             let scale = [1e-3, 1.0, 1e3][case % 3];
-            let mut point = || {
-                DVec3::new(uniform(&mut seed), uniform(&mut seed), uniform(&mut seed)) * scale
-                    + corner
-            };
+            let mut point =
+                || DVec3::new(random.unit(), random.unit(), random.unit()) * scale + corner;
             let (p, q) = (point(), point());
             let held = Aabb::new(p.min(q), p.max(q));
             let mut block = Block::EMPTY;
@@ -438,7 +429,7 @@ mod tests {
             // A point of the box's surface: a corner, or a face's point.
             let mut on = held.min;
             for k in 0..3 {
-                let t = uniform(&mut seed);
+                let t = random.unit();
                 on[k] = match (case / 3 + k) % 3 {
                     0 => held.min[k],
                     1 => held.max[k],
@@ -446,9 +437,9 @@ mod tests {
                 };
             }
             let mut dir = DVec3::new(
-                uniform(&mut seed) - 0.5,
-                uniform(&mut seed) - 0.5,
-                uniform(&mut seed) - 0.5,
+                random.unit() - 0.5,
+                random.unit() - 0.5,
+                random.unit() - 0.5,
             );
             // Along an axis now and then: the other two reciprocals are 0.
             if case % 7 == 0 {
@@ -456,12 +447,9 @@ mod tests {
                 dir[case % 3] = if case % 2 == 0 { 1.0 } else { -1.0 };
             }
             let dir = dir.normalize();
-            let back = 10.0 * scale * uniform(&mut seed);
+            let back = 10.0 * scale * random.unit();
             let origin = on - back * dir;
-            let inv_dir = dir.to_array().map(|c| {
-                let inv = 1.0 / c;
-                if inv.is_finite() { inv } else { 0.0 }
-            });
+            let inv_dir = PreparedRay::new(Ray::new(origin, dir)).inv_dir;
             let ray = BoxRay::relative_to(origin.to_array(), inv_dir, corner);
             let (mask, entry) = Baseline.hit(&block, 1, &ray, f32::INFINITY);
             assert_eq!(
