@@ -13,11 +13,11 @@ pub use bvh::{Bvh, BvhStack, BvhStats};
 pub use light_buffer::{Candidates, LightBuffer, LightBufferStats};
 pub use octree::{
     Baseline, BoxLanes, DEFAULT_MEMORY_BUDGET_MIB, Octree, OctreeCell, OctreeError, OctreeParams,
-    OctreeStats, PacketStack, PredictedCost, WalkStack,
+    OctreeStats, OneByOne, PacketStack, PredictedCost, WalkStack,
 };
 pub use primitives::{
     ClosestHit, MAX_SHADOW_CROSSINGS, Primitives, ShadowCrossings, closest_brute_force,
-    occlusion_among, occlusion_brute_force,
+    occlusion_among, occlusion_among_in_lanes, occlusion_brute_force,
 };
 pub use walk_log::WalkLog;
 

@@ -5,7 +5,9 @@
 // Lane loops index several arrays by the same lane number.
 #![allow(clippy::needless_range_loop)]
 
-use crate::shapes::{PacketHits, PreparedRay, RayPacket, Shape, ShapeHit, probe_past, wins};
+use crate::shapes::{
+    PacketHits, PreparedRay, RayPacket, Shape, ShapeHit, Triangle, TriangleLanes, probe_past, wins,
+};
 use crate::stats::Counter;
 
 /// The shapes a ray query runs over, and what it must know of each.
@@ -30,6 +32,17 @@ impl<'a> Primitives<'a> {
         }
     }
 
+    /// Whether at least half of `shapes` are triangles: where single rays
+    /// test triangles four at a time ([`crate::shapes::TriangleLanes`];
+    /// elsewhere sorting them out costs more than the batches save).
+    pub fn mostly_triangles(shapes: &[Shape]) -> bool {
+        let triangles = shapes
+            .iter()
+            .filter(|s| matches!(s, Shape::Triangle(_)))
+            .count();
+        2 * triangles >= shapes.len()
+    }
+
     /// Shape `index`'s nearest hit in `(0, t_max)`, on its outside only if
     /// it is one-sided.
     #[inline(always)]
@@ -50,6 +63,33 @@ impl<'a> Primitives<'a> {
         (index as usize) < self.shapes.len()
             && !self.is_transparent(index)
             && self.intersect(index, ray, t_max).is_some()
+    }
+
+    /// Shape `index` as a triangle a single ray's closest-hit query may
+    /// test four at a time ([`TriangleBatch`]): a two-sided one.
+    #[inline(always)]
+    pub(crate) fn lane_triangle(&self, index: u32) -> Option<&'a Triangle> {
+        match self.shapes.get(index as usize) {
+            Some(Shape::Triangle(t)) if self.one_sided.get(index as usize) != Some(&true) => {
+                Some(t)
+            }
+            _ => None,
+        }
+    }
+
+    /// Shape `index` as a triangle a shadow ray may test four at a time,
+    /// and whether it lets light through: a transparent one (crossed from
+    /// either side) or an opaque two-sided one.
+    #[inline(always)]
+    pub(crate) fn shadow_triangle(&self, index: u32) -> Option<(&'a Triangle, bool)> {
+        match self.shapes.get(index as usize) {
+            Some(Shape::Triangle(t)) => {
+                let transparent = self.is_transparent(index);
+                (transparent || self.one_sided.get(index as usize) != Some(&true))
+                    .then_some((t, transparent))
+            }
+            _ => None,
+        }
     }
 
     #[inline(always)]
@@ -138,6 +178,146 @@ pub(crate) fn test_closest<C: Counter>(
         if better {
             *best = Some(ClosestHit { shape: index, hit });
         }
+    }
+}
+
+/// Up to four triangles (from [`Primitives::lane_triangle`]) waiting to be
+/// tested against a single ray together ([`TriangleLanes::intersect_four`]),
+/// with the answers [`test_closest`] and [`test_occlusion`] give one by
+/// one: a closest hit is the lexicographic minimum of `(t, index)` in any
+/// order, and a shadow ray is blocked by any of them alike.
+pub(crate) struct TriangleBatch<'a> {
+    triangles: [&'a Triangle; 4],
+    index: [u32; 4],
+    /// Lanes whose triangle lets light through (shadow rays only).
+    transparent: u32,
+    len: usize,
+}
+
+/// What the lanes of a batch hold before it is full (never tested).
+static UNUSED_LANE: Triangle = Triangle {
+    vertices: [
+        crate::math::DVec3::ZERO,
+        crate::math::DVec3::X,
+        crate::math::DVec3::Y,
+    ],
+    vertex_normals: crate::shapes::NO_NORMALS,
+};
+
+impl<'a> TriangleBatch<'a> {
+    #[inline(always)]
+    pub(crate) fn new() -> Self {
+        Self {
+            triangles: [&UNUSED_LANE; 4],
+            index: [0; 4],
+            transparent: 0,
+            len: 0,
+        }
+    }
+
+    /// Adds triangle `triangle` (shape `index`, letting light through if
+    /// `transparent`); `true` once full.
+    #[inline(always)]
+    pub(crate) fn push(&mut self, index: u32, triangle: &'a Triangle, transparent: bool) -> bool {
+        let slot = self.len & 3;
+        self.triangles[slot] = triangle;
+        self.index[slot] = index;
+        let bit = 1 << slot;
+        self.transparent = (self.transparent & !bit) | (transparent as u32 * bit);
+        self.len = slot + 1;
+        self.len == 4
+    }
+
+    /// Tests the waiting triangles as [`test_closest`] would, and empties
+    /// the batch. One alone is tested as a single ray's test is.
+    #[inline(always)]
+    pub(crate) fn closest<L: TriangleLanes>(
+        &mut self,
+        prims: &Primitives,
+        ray: &PreparedRay,
+        best: &mut Option<ClosestHit>,
+        t_max: f64,
+        lanes: L,
+    ) {
+        let len = std::mem::take(&mut self.len);
+        if len <= 1 {
+            if len == 1 {
+                test_closest(
+                    prims,
+                    self.index[0],
+                    ray,
+                    best,
+                    t_max,
+                    &mut crate::stats::NoCounts,
+                );
+            }
+            return;
+        }
+        // The limit when the batch starts: a lane hit past a nearer one
+        // found beside it loses to it below, as it would have been cut
+        // off one by one.
+        let limit = best.map_or(t_max, |b| b.hit.t);
+        let probe = if best.is_some() {
+            probe_past(limit)
+        } else {
+            limit
+        };
+        let hits = lanes.intersect_four(self.triangles, (1 << len) - 1, ray, probe);
+        let mut hit_lanes = hits.hit;
+        while hit_lanes != 0 {
+            let j = hit_lanes.trailing_zeros() as usize;
+            hit_lanes &= hit_lanes - 1;
+            let (index, t) = (self.index[j], hits.t[j]);
+            if best.is_none_or(|b| wins(t, index, b.hit.t, b.shape)) {
+                let hit = ShapeHit {
+                    t,
+                    b1: hits.v[j] / hits.det[j],
+                    b2: hits.w[j] / hits.det[j],
+                };
+                *best = Some(ClosestHit { shape: index, hit });
+            }
+        }
+    }
+
+    /// Tests the waiting triangles as [`test_occlusion`] would, and
+    /// empties the batch: `true` once an opaque one blocks the ray; the
+    /// transparent ones crossed are recorded (which, like the crossings,
+    /// does not depend on the order).
+    #[inline(always)]
+    pub(crate) fn blocks<L: TriangleLanes>(
+        &mut self,
+        prims: &Primitives,
+        ray: &PreparedRay,
+        t_max: f64,
+        found: &mut ShadowCrossings,
+        lanes: L,
+    ) -> bool {
+        let len = std::mem::take(&mut self.len);
+        if len <= 1 {
+            return len == 1
+                && test_occlusion(
+                    prims,
+                    self.index[0],
+                    ray,
+                    t_max,
+                    found,
+                    &mut crate::stats::NoCounts,
+                );
+        }
+        let hits = lanes.intersect_four(self.triangles, (1 << len) - 1, ray, t_max);
+        let opaque = hits.hit & !self.transparent;
+        if opaque != 0 {
+            found.blocked = true;
+            found.blocker = self.index[opaque.trailing_zeros() as usize];
+            return true;
+        }
+        let mut crossed = hits.hit;
+        while crossed != 0 {
+            let j = crossed.trailing_zeros() as usize;
+            crossed &= crossed - 1;
+            found.add(hits.t[j], self.index[j]);
+        }
+        false
     }
 }
 
@@ -319,6 +499,41 @@ pub fn occlusion_among<C: Counter>(
             }
         }
     }
+}
+
+/// [`occlusion_among`] with the listed triangles tested four at a time by
+/// `lanes` (one by one where the level cannot), nothing counted.
+#[inline(always)]
+pub fn occlusion_among_in_lanes<L: TriangleLanes>(
+    prims: &Primitives,
+    lists: [&[u32]; 2],
+    ray: &PreparedRay,
+    t_max: f64,
+    found: &mut ShadowCrossings,
+    lanes: L,
+) {
+    // Most lists are short (one or two shapes on the default scene): they
+    // go as they went.
+    if !(L::FOUR_AT_ONCE && lists[1].len() >= 4) {
+        occlusion_among(prims, lists, ray, t_max, found, &mut crate::stats::NoCounts);
+        return;
+    }
+    found.clear();
+    let mut batch = TriangleBatch::new();
+    for list in lists {
+        for &i in list {
+            let blocked = if let Some((triangle, transparent)) = prims.shadow_triangle(i) {
+                batch.push(i, triangle, transparent)
+                    && batch.blocks(prims, ray, t_max, found, lanes)
+            } else {
+                test_occlusion(prims, i, ray, t_max, found, &mut crate::stats::NoCounts)
+            };
+            if blocked {
+                return;
+            }
+        }
+    }
+    batch.blocks(prims, ray, t_max, found, lanes);
 }
 
 #[cfg(test)]

@@ -4,8 +4,9 @@
 //! force) the integrator asks.
 
 use crate::accel::{
-    Bvh, BvhStack, Candidates, ClosestHit, LightBuffer, Octree, Primitives, ShadowCrossings,
-    WalkLog, WalkStack, closest_brute_force, occlusion_among, occlusion_brute_force,
+    BoxLanes, Bvh, BvhStack, Candidates, ClosestHit, LightBuffer, Octree, OneByOne, Primitives,
+    ShadowCrossings, WalkLog, WalkStack, closest_brute_force, occlusion_among,
+    occlusion_among_in_lanes, occlusion_brute_force,
 };
 use crate::camera::{Camera, CameraError, CameraSpec, sample_offsets};
 use crate::limits::LimitError;
@@ -105,34 +106,52 @@ pub(super) struct Query<'s, C> {
     pub scratch: &'s mut Scratch,
 }
 
-/// A single ray's closest hit (nothing counted), as a function compiled
-/// for the render's SIMD level ([`SingleRays`]).
+/// A single ray's query (nothing counted) for the octree's lanes `L`: a
+/// closest hit, a shadow ray's crossings, or those among a light buffer's
+/// few shapes.
+trait SingleQuery {
+    type Output;
+    fn run<L: BoxLanes>(self, lanes: L) -> Self::Output;
+}
+
+/// `Q` with the lanes `L`, as a function compiled for the render's SIMD
+/// level ([`SingleRays`]).
+struct InLanes<Q, L>(Q, L);
+
+impl<Q: SingleQuery, L: BoxLanes> pulp::WithSimd for InLanes<Q, L> {
+    type Output = Q::Output;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) -> Q::Output {
+        self.0.run(self.1)
+    }
+}
+
+/// A single ray's closest hit.
 struct ClosestQuery<'q> {
     octree: &'q Octree,
     prims: &'q Primitives<'q>,
     ray: &'q PreparedRay,
     stack: &'q mut WalkStack,
-    simd: pulp::x86::V3,
 }
 
-impl pulp::WithSimd for ClosestQuery<'_> {
+impl SingleQuery for ClosestQuery<'_> {
     type Output = Option<ClosestHit>;
 
     #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _simd: S) -> Option<ClosestHit> {
+    fn run<L: BoxLanes>(self, lanes: L) -> Option<ClosestHit> {
         self.octree.closest_inline(
             self.prims,
             self.ray,
             f64::INFINITY,
             self.stack,
             &mut NoCounts,
-            self.simd,
+            lanes,
         )
     }
 }
 
-/// A shadow ray's crossings (nothing counted), as a function compiled for
-/// the render's SIMD level ([`SingleRays`]).
+/// A shadow ray's crossings.
 struct OcclusionQuery<'q> {
     octree: &'q Octree,
     prims: &'q Primitives<'q>,
@@ -140,14 +159,13 @@ struct OcclusionQuery<'q> {
     distance: f64,
     crossings: &'q mut ShadowCrossings,
     stack: &'q mut WalkStack,
-    simd: pulp::x86::V3,
 }
 
-impl pulp::WithSimd for OcclusionQuery<'_> {
+impl SingleQuery for OcclusionQuery<'_> {
     type Output = ();
 
     #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+    fn run<L: BoxLanes>(self, lanes: L) {
         self.octree.occlusion_inline(
             self.prims,
             self.ray,
@@ -155,13 +173,12 @@ impl pulp::WithSimd for OcclusionQuery<'_> {
             self.crossings,
             self.stack,
             &mut NoCounts,
-            self.simd,
+            lanes,
         );
     }
 }
 
-/// A shadow ray's crossings among a light buffer's few shapes (nothing
-/// counted), compiled for the render's SIMD level.
+/// A shadow ray's crossings among a light buffer's few shapes.
 struct AmongQuery<'q> {
     prims: &'q Primitives<'q>,
     lists: [&'q [u32]; 2],
@@ -170,18 +187,18 @@ struct AmongQuery<'q> {
     crossings: &'q mut ShadowCrossings,
 }
 
-impl pulp::WithSimd for AmongQuery<'_> {
+impl SingleQuery for AmongQuery<'_> {
     type Output = ();
 
     #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _simd: S) {
-        occlusion_among(
+    fn run<L: BoxLanes>(self, lanes: L) {
+        occlusion_among_in_lanes(
             self.prims,
             self.lists,
             self.ray,
             self.distance,
             self.crossings,
-            &mut NoCounts,
+            lanes,
         );
     }
 }
@@ -280,6 +297,9 @@ pub struct Renderer<'a> {
     is_transparent: Vec<bool>,
     /// Per shape: seen from outside only ([`Sides::One`]); empty otherwise.
     one_sided: Vec<bool>,
+    /// Single rays test triangles four at a time
+    /// ([`Primitives::mostly_triangles`]).
+    triangle_lanes: bool,
     /// The scene's materials and background as this render shades them
     /// (decoded into linear light for a linear render of display values).
     pub(super) materials: Vec<Material>,
@@ -369,6 +389,7 @@ impl<'a> Renderer<'a> {
             bvh: None,
             routes: Routes::new(&settings, octree, false),
             shadow_hints: scene.shapes.len() > HINTS_MIN_SHAPES,
+            triangle_lanes: Primitives::mostly_triangles(&scene.shapes),
             light_buffer: None,
             settings,
             camera,
@@ -497,6 +518,18 @@ impl<'a> Renderer<'a> {
         }
     }
 
+    /// Runs a single ray's `query` compiled for `simd`, its triangles four
+    /// at a time where the scene is mostly triangles (one by one
+    /// elsewhere, in a copy of the code of its own).
+    #[inline(always)]
+    fn single<Q: SingleQuery>(&self, simd: pulp::x86::V3, query: Q) -> Q::Output {
+        if self.triangle_lanes {
+            pulp::Simd::vectorize(simd, InLanes(query, simd))
+        } else {
+            pulp::Simd::vectorize(simd, InLanes(query, OneByOne(simd)))
+        }
+    }
+
     pub(super) fn closest<C: Counter>(
         &self,
         ray: &PreparedRay,
@@ -528,14 +561,13 @@ impl<'a> Renderer<'a> {
             if !C::COUNTS
                 && let Some(simd) = self.single_rays.avx2()
             {
-                return pulp::Simd::vectorize(
+                return self.single(
                     simd,
                     ClosestQuery {
                         octree: self.octree,
                         prims: &prims,
                         ray,
                         stack,
-                        simd,
                     },
                 );
             }
@@ -600,7 +632,7 @@ impl<'a> Renderer<'a> {
         };
         if let Some(lists) = few {
             match self.single_rays.avx2() {
-                Some(simd) => pulp::Simd::vectorize(
+                Some(simd) => self.single(
                     simd,
                     AmongQuery {
                         prims: &prims,
@@ -631,7 +663,7 @@ impl<'a> Renderer<'a> {
             }
         } else if route == Route::Octree {
             match self.single_rays.avx2() {
-                Some(simd) if !C::COUNTS => pulp::Simd::vectorize(
+                Some(simd) if !C::COUNTS => self.single(
                     simd,
                     OcclusionQuery {
                         octree: self.octree,
@@ -640,7 +672,6 @@ impl<'a> Renderer<'a> {
                         distance,
                         crossings,
                         stack,
-                        simd,
                     },
                 ),
                 _ => self

@@ -8,6 +8,7 @@ mod plane;
 mod quadric;
 mod sphere;
 mod triangle;
+mod triangle_lanes;
 
 pub use cone::Cone;
 pub(crate) use hit::unit_or_none;
@@ -16,7 +17,8 @@ pub use packet::{LaneHits, PacketHits, RayPacket};
 pub use plane::Plane;
 pub use quadric::Quadric;
 pub use sphere::Sphere;
-pub use triangle::{Triangle, triangle_overlaps_box};
+pub use triangle::{NO_NORMALS, Triangle, triangle_overlaps_box};
+pub use triangle_lanes::{FourHits, TriangleLanes};
 
 use crate::math::{Aabb, DVec3, Ray};
 

@@ -13,7 +13,7 @@
 
 use super::node::{Cell, Node};
 use crate::math::Aabb;
-use crate::shapes::{PreparedRay, Shape};
+use crate::shapes::{FourHits, PreparedRay, Shape, Triangle, TriangleLanes};
 
 /// Lanes a node's children take: one per octant.
 pub(super) const WIDTH: usize = 8;
@@ -156,7 +156,7 @@ impl NodeBoxes {
 
 /// How the eight boxes of a node's children are tested: the lanes' code
 /// for a SIMD level. Each answers the same (see [`BoxLanes::hit`]).
-pub trait BoxLanes: Copy {
+pub trait BoxLanes: TriangleLanes + Copy {
     /// The lanes `0 .. count` (at most eight) of `block` whose box `ray`
     /// may meet before `limit` (from `limit_f32`), and where it
     /// may enter each (not before 0): never a lane it does meet, nor a
@@ -173,6 +173,65 @@ pub trait BoxLanes: Copy {
 /// Baseline x86-64 (or any machine): plain loops over the lanes.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Baseline;
+
+/// Baseline tests triangles one by one.
+impl TriangleLanes for Baseline {
+    const FOUR_AT_ONCE: bool = false;
+
+    fn intersect_four(
+        self,
+        triangles: [&Triangle; 4],
+        live: u32,
+        ray: &PreparedRay,
+        t_max: f64,
+    ) -> FourHits {
+        let mut four = FourHits {
+            hit: 0,
+            t: [0.0; 4],
+            v: [0.0; 4],
+            w: [1.0; 4],
+            det: [1.0; 4],
+        };
+        for (j, triangle) in triangles.iter().enumerate() {
+            if live >> j & 1 == 1
+                && let Some(hit) = triangle.intersect(ray, t_max)
+            {
+                // Barycentrics as quotients over 1, which they equal.
+                (four.t[j], four.v[j], four.w[j]) = (hit.t, hit.b1, hit.b2);
+                four.hit |= 1 << j;
+            }
+        }
+        four
+    }
+}
+
+/// Another level's boxes with triangles tested one by one: for scenes of
+/// few triangles, where sorting them out for batches costs more than the
+/// batches save (and a separate copy of the walk keeps their code as it
+/// was).
+#[derive(Clone, Copy, Debug)]
+pub struct OneByOne<L>(pub L);
+
+impl<L: BoxLanes> TriangleLanes for OneByOne<L> {
+    const FOUR_AT_ONCE: bool = false;
+
+    fn intersect_four(
+        self,
+        triangles: [&Triangle; 4],
+        live: u32,
+        ray: &PreparedRay,
+        t_max: f64,
+    ) -> FourHits {
+        Baseline.intersect_four(triangles, live, ray, t_max)
+    }
+}
+
+impl<L: BoxLanes> BoxLanes for OneByOne<L> {
+    #[inline(always)]
+    fn hit(self, block: &Block, count: u32, ray: &BoxRay, limit: f32) -> (u32, [f32; WIDTH]) {
+        self.0.hit(block, count, ray, limit)
+    }
+}
 
 impl BoxLanes for Baseline {
     #[inline(always)]

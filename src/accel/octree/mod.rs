@@ -40,7 +40,7 @@ mod visit;
 mod walk;
 mod wide_walk;
 
-pub use bounds::{Baseline, BoxLanes};
+pub use bounds::{Baseline, BoxLanes, OneByOne};
 pub use packet_walk::PacketStack;
 pub use params::{DEFAULT_MEMORY_BUDGET_MIB, OctreeCell, OctreeError, OctreeParams, OctreeStats};
 pub use predict::PredictedCost;

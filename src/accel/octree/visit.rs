@@ -17,6 +17,7 @@
 //! and the shading of the hits (packets shade each light across their
 //! lanes; both call the same per-hit steps in `render::integrator`).
 
+use crate::shapes::TriangleLanes;
 use crate::simd::F64s;
 use crate::stats::Counter;
 use crate::stats::walk_record::WalkEnd;
@@ -130,7 +131,8 @@ pub(super) trait Visitor {
 /// What a single ray's walk does at its leaves.
 pub(super) trait LeafVisitor: Visitor<Limit = f64> {
     /// Tests the shapes of a leaf the ray leaves at `t_exit`; `true` to stop.
-    fn visit_leaf(&mut self, refs: &[u32], t_exit: f64) -> bool;
+    /// `lanes` test triangles four at a time where the level can.
+    fn visit_leaf<L: TriangleLanes>(&mut self, refs: &[u32], t_exit: f64, lanes: L) -> bool;
     /// Why the walk ends when `visit_leaf` says stop, and when the next
     /// cell starts beyond the limit.
     const STOPPED: WalkEnd;

@@ -8,10 +8,10 @@ use super::tree::Octree;
 use super::visit::{CellEntry, CellStack, LeafVisitor, Mailbox, Visitor};
 use super::wide_walk::WideStack;
 use crate::accel::primitives::{
-    ClosestHit, Primitives, ShadowCrossings, test_closest, test_occlusion,
+    ClosestHit, Primitives, ShadowCrossings, TriangleBatch, test_closest, test_occlusion,
 };
 use crate::limits::MAX_OCTREE_DEPTH;
-use crate::shapes::PreparedRay;
+use crate::shapes::{PreparedRay, TriangleLanes};
 use crate::stats::Counter;
 use crate::stats::walk_record::{CellVisit, StepKind, WalkEnd};
 
@@ -55,7 +55,7 @@ impl Octree {
             self.walk_wide(ray, &mut stack.wide, &mut visitor, lanes);
         } else {
             let limit = visitor.limit();
-            self.walk(ray, limit, stack, &mut visitor);
+            self.walk(ray, limit, stack, &mut visitor, lanes);
         }
         visitor.best
     }
@@ -106,7 +106,7 @@ impl Octree {
         if !C::COUNTS && self.has_boxes() {
             self.walk_wide(ray, &mut stack.wide, &mut visitor, lanes);
         } else {
-            self.walk(ray, t_max, stack, &mut visitor);
+            self.walk(ray, t_max, stack, &mut visitor, lanes);
         }
     }
 
@@ -142,12 +142,13 @@ impl Octree {
     /// The traversal: pops cells front to back until the visitor stops or
     /// nothing further along the ray can matter.
     #[inline(always)]
-    pub(super) fn walk<V: LeafVisitor>(
+    pub(super) fn walk<V: LeafVisitor, L: TriangleLanes>(
         &self,
         ray: &PreparedRay,
         t_max: f64,
         stack: &mut WalkStack,
         visitor: &mut V,
+        lanes: L,
     ) {
         if self.nodes.is_empty() {
             visitor.counter().walk_end(WalkEnd::MissedOctree);
@@ -193,7 +194,7 @@ impl Octree {
                 visitor.counter().cell(|| visit(StepKind::Leaf));
                 let first = node.first as usize;
                 let refs = &self.refs[first..first + node.count() as usize];
-                if visitor.visit_leaf(refs, e.t1) {
+                if visitor.visit_leaf(refs, e.t1, lanes) {
                     visitor.counter().walk_end(V::STOPPED);
                     return;
                 }
@@ -332,9 +333,34 @@ impl<C: Counter> LeafVisitor for ClosestVisitor<'_, C> {
     const BEYOND_LIMIT: WalkEnd = WalkEnd::CellsBeyondHit;
 
     #[inline(always)]
-    fn visit_leaf(&mut self, refs: &[u32], t_exit: f64) -> bool {
+    fn visit_leaf<L: TriangleLanes>(&mut self, refs: &[u32], t_exit: f64, lanes: L) -> bool {
+        // Uncounted, where the lanes can (triangles are most shapes):
+        // triangles four at a time, the rest one by one.
+        if C::COUNTS || !L::FOUR_AT_ONCE {
+            for &i in refs {
+                if !self.mailbox.seen(i) {
+                    test_closest(
+                        self.prims,
+                        i,
+                        self.ray,
+                        &mut self.best,
+                        self.t_max,
+                        self.counter,
+                    );
+                }
+            }
+            return self.best.is_some_and(|b| b.hit.t < t_exit);
+        }
+        let mut batch = TriangleBatch::new();
         for &i in refs {
-            if !self.mailbox.seen(i) {
+            if self.mailbox.seen(i) {
+                continue;
+            }
+            if let Some(triangle) = self.prims.lane_triangle(i) {
+                if batch.push(i, triangle, false) {
+                    batch.closest(self.prims, self.ray, &mut self.best, self.t_max, lanes);
+                }
+            } else {
                 test_closest(
                     self.prims,
                     i,
@@ -345,6 +371,7 @@ impl<C: Counter> LeafVisitor for ClosestVisitor<'_, C> {
                 );
             }
         }
+        batch.closest(self.prims, self.ray, &mut self.best, self.t_max, lanes);
         // A hit exactly on the exit face may tie with one in the next cell:
         // only a hit strictly inside this cell ends the walk.
         self.best.is_some_and(|b| b.hit.t < t_exit)
@@ -377,21 +404,34 @@ impl<C: Counter> LeafVisitor for OcclusionVisitor<'_, C> {
     const BEYOND_LIMIT: WalkEnd = WalkEnd::CellsBeyondLight;
 
     #[inline(always)]
-    fn visit_leaf(&mut self, refs: &[u32], _t_exit: f64) -> bool {
+    fn visit_leaf<L: TriangleLanes>(&mut self, refs: &[u32], _t_exit: f64, lanes: L) -> bool {
+        // Uncounted, where the lanes can (triangles are most shapes):
+        // triangles four at a time, the rest one by one (whichever blocks
+        // first, the ray is blocked).
+        let batching = !C::COUNTS && L::FOUR_AT_ONCE;
+        let mut batch = TriangleBatch::new();
         for &i in refs {
-            if !self.mailbox.seen(i)
-                && test_occlusion(
-                    self.prims,
-                    i,
-                    self.ray,
-                    self.t_max,
-                    self.found,
-                    self.counter,
-                )
-            {
+            if self.mailbox.seen(i) {
+                continue;
+            }
+            let blocked =
+                if batching && let Some((triangle, transparent)) = self.prims.shadow_triangle(i) {
+                    batch.push(i, triangle, transparent)
+                        && batch.blocks(self.prims, self.ray, self.t_max, self.found, lanes)
+                } else {
+                    test_occlusion(
+                        self.prims,
+                        i,
+                        self.ray,
+                        self.t_max,
+                        self.found,
+                        self.counter,
+                    )
+                };
+            if blocked {
                 return true;
             }
         }
-        false
+        batch.blocks(self.prims, self.ray, self.t_max, self.found, lanes)
     }
 }

@@ -84,7 +84,7 @@ impl Octree {
                 if node.is_leaf() {
                     let first = node.first as usize;
                     let refs = &self.refs[first..first + node.count() as usize];
-                    if visitor.visit_leaf(refs, f64::NEG_INFINITY) {
+                    if visitor.visit_leaf(refs, f64::NEG_INFINITY, lanes) {
                         return;
                     }
                     break;
