@@ -77,9 +77,9 @@ impl<'a> Primitives<'a> {
         }
     }
 
-    /// Shape `index` as a triangle a shadow ray may test four at a time,
-    /// and whether it lets light through: a transparent one (crossed from
-    /// either side) or an opaque two-sided one.
+    /// Shape `index` as a triangle a shadow ray may test four at a time
+    /// (a transparent one, crossed from either side, or an opaque
+    /// two-sided one), with `true` if it is the transparent kind.
     #[inline(always)]
     pub(crate) fn shadow_triangle(&self, index: u32) -> Option<(&'a Triangle, bool)> {
         match self.shapes.get(index as usize) {
@@ -181,7 +181,8 @@ pub(crate) fn test_closest<C: Counter>(
     }
 }
 
-/// Up to four triangles (from [`Primitives::lane_triangle`]) waiting to be
+/// Up to four triangles (from [`Primitives::lane_triangle`] for a closest
+/// hit, [`Primitives::shadow_triangle`] for a shadow ray) waiting to be
 /// tested against a single ray together ([`TriangleLanes::intersect_four`]),
 /// with the answers [`test_closest`] and [`test_occlusion`] give one by
 /// one: a closest hit is the lexicographic minimum of `(t, index)` in any
@@ -194,7 +195,9 @@ pub(crate) struct TriangleBatch<'a> {
     len: usize,
 }
 
-/// What the lanes of a batch hold before it is full (never tested).
+/// What a batch's lanes hold before anything is pushed: computed with the
+/// rest, then masked out by `live` (as are the stale triangles spare
+/// lanes keep from the batch before).
 static UNUSED_LANE: Triangle = Triangle {
     vertices: [
         crate::math::DVec3::ZERO,
@@ -219,6 +222,7 @@ impl<'a> TriangleBatch<'a> {
     /// `transparent`); `true` once full.
     #[inline(always)]
     pub(crate) fn push(&mut self, index: u32, triangle: &'a Triangle, transparent: bool) -> bool {
+        debug_assert!(self.len < 4, "a full batch is tested before the next push");
         let slot = self.len & 3;
         self.triangles[slot] = triangle;
         self.index[slot] = index;
@@ -253,9 +257,9 @@ impl<'a> TriangleBatch<'a> {
             }
             return;
         }
-        // The limit when the batch starts: a lane hit past a nearer one
-        // found beside it loses to it below, as it would have been cut
-        // off one by one.
+        // The limit when the batch is tested: a lane hit past a nearer
+        // one found beside it loses to it below, as it would have been
+        // cut off one by one.
         let limit = best.map_or(t_max, |b| b.hit.t);
         let probe = if best.is_some() {
             probe_past(limit)
@@ -504,7 +508,7 @@ pub fn occlusion_among<C: Counter>(
 /// [`occlusion_among`] with the listed triangles tested four at a time by
 /// `lanes` (one by one where the level cannot), nothing counted.
 #[inline(always)]
-pub fn occlusion_among_in_lanes<L: TriangleLanes>(
+pub(crate) fn occlusion_among_in_lanes<L: TriangleLanes>(
     prims: &Primitives,
     lists: [&[u32]; 2],
     ray: &PreparedRay,

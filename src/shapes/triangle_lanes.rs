@@ -205,18 +205,18 @@ mod tests {
     use super::*;
     use crate::math::{DVec3, Ray, XorShift};
 
-    /// Four triangles' lane test answers what four single tests answer, to
-    /// the bit: which are hit, where, and the barycentrics. The triangles
-    /// share edges and vertices (fans, strips), are slivers, or lie 1e6
-    /// from the origin at sizes 1e-4 to 1e4; the rays aim at vertices,
-    /// edge midpoints and interiors, run parallel to or in a triangle's
-    /// plane, start on one, and meet limits equal to a hit's `t`.
     /// A point in the cube of side `scale` around `centre`.
     fn point(random: &mut XorShift, scale: f64, centre: DVec3) -> DVec3 {
         let mut coordinate = || random.unit() - 0.5;
         centre + scale * DVec3::new(coordinate(), coordinate(), coordinate())
     }
 
+    /// Four triangles' lane test answers what four single tests answer, to
+    /// the bit: which are hit, where, and the barycentrics. The triangles
+    /// share edges and vertices (fans, strips), are slivers, or lie 1e6
+    /// from the origin at sizes 1e-4 to 1e4; the rays aim at vertices,
+    /// edge midpoints and interiors, run parallel to or in a triangle's
+    /// plane, start on one, and meet limits equal to a hit's `t`.
     #[test]
     fn four_lanes_answer_as_four_single_tests() {
         let Some(simd) = pulp::x86::V3::try_new() else {

@@ -156,7 +156,7 @@ impl NodeBoxes {
 
 /// How the eight boxes of a node's children are tested: the lanes' code
 /// for a SIMD level. Each answers the same (see [`BoxLanes::hit`]).
-pub trait BoxLanes: TriangleLanes + Copy {
+pub trait BoxLanes: TriangleLanes {
     /// The lanes `0 .. count` (at most eight) of `block` whose box `ray`
     /// may meet before `limit` (from `limit_f32`), and where it
     /// may enter each (not before 0): never a lane it does meet, nor a
@@ -205,12 +205,12 @@ impl TriangleLanes for Baseline {
     }
 }
 
-/// Another level's boxes with triangles tested one by one: for scenes of
-/// few triangles, where sorting them out for batches costs more than the
-/// batches save (and a separate copy of the walk keeps their code as it
-/// was).
+/// Another level's boxes with triangles tested one by one: for scenes
+/// where fewer than half the shapes are triangles, where sorting them out
+/// for batches costs more than the batches save (and a copy of the walk
+/// of its own keeps their code as it was).
 #[derive(Clone, Copy, Debug)]
-pub struct OneByOne<L>(pub L);
+pub(crate) struct OneByOne<L>(pub L);
 
 impl<L: BoxLanes> TriangleLanes for OneByOne<L> {
     const FOUR_AT_ONCE: bool = false;

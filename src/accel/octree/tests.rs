@@ -445,3 +445,176 @@ fn a_vertex_fan_stays_a_leaf_and_a_larger_fan_splits_as_before() {
     }
     assert!(hits > 32, "{hits} hits");
 }
+
+/// Single rays that test triangles four at a time (AVX2 lanes) answer as
+/// those testing them one by one, on scenes that mix triangle fans and
+/// strips sharing vertices, coincident and coplanar triangles, slivers,
+/// spheres, transparent shapes (crossed from both sides, more than
+/// `MAX_SHADOW_CROSSINGS` of them along some rays) and one-sided ones:
+/// the closest hit to the bit (ties at one `t` by the lower index), the
+/// shadow answer and its crossings, through the walk and through a light
+/// buffer's lists alike.
+#[test]
+fn triangles_four_at_a_time_answer_as_one_by_one() {
+    use crate::accel::primitives::{occlusion_among, occlusion_among_in_lanes};
+    use crate::math::XorShift;
+    use crate::shapes::{Triangle, TriangleLanes};
+    let Some(simd) = pulp::x86::V3::try_new() else {
+        eprintln!("no AVX2 here: nothing to compare");
+        return;
+    };
+    let mut random = XorShift(0x9e37_79b9_7f4a_7c15);
+    let mut shapes = Vec::new();
+    // Fans of 12 around shared hubs, each fan in one plane.
+    for fan in 0..40 {
+        let hub = DVec3::new(
+            random.unit() * 4.0,
+            random.unit() * 4.0,
+            (fan % 5) as f64 * 0.5,
+        );
+        let rim: Vec<DVec3> = (0..13)
+            .map(|k| {
+                let a = k as f64 * std::f64::consts::TAU / 12.0;
+                hub + DVec3::new(a.cos(), a.sin(), 0.0) * (0.3 + random.unit())
+            })
+            .collect();
+        for k in 0..12 {
+            shapes.extend(Triangle::new([hub, rim[k], rim[k + 1]]).map(Shape::Triangle));
+        }
+    }
+    // Strips, slivers and coincident copies.
+    for _ in 0..300 {
+        let a = DVec3::new(
+            random.unit() * 4.0,
+            random.unit() * 4.0,
+            random.unit() * 2.0,
+        );
+        let b = a + DVec3::new(
+            random.unit() - 0.5,
+            random.unit() - 0.5,
+            random.unit() - 0.5,
+        );
+        let c = a + (b - a) * 0.5 + DVec3::new(1e-7, random.unit() * 0.3, 0.0);
+        if let Some(t) = Triangle::new([a, b, c]) {
+            if random.unit() < 0.2 {
+                shapes.push(Shape::Triangle(t.clone()));
+            }
+            shapes.push(Shape::Triangle(t));
+        }
+    }
+    for _ in 0..20 {
+        let centre = DVec3::new(
+            random.unit() * 4.0,
+            random.unit() * 4.0,
+            random.unit() * 2.0,
+        );
+        shapes.push(Shape::Sphere(Sphere::new(
+            centre,
+            0.05 + 0.3 * random.unit(),
+        )));
+    }
+    let triangles: Vec<&Triangle> = shapes
+        .iter()
+        .filter_map(|s| match s {
+            Shape::Triangle(t) => Some(t),
+            _ => None,
+        })
+        .collect();
+    let transparent: Vec<bool> = (0..shapes.len()).map(|_| random.unit() < 0.5).collect();
+    let one_sided: Vec<bool> = (0..shapes.len()).map(|_| random.unit() < 0.2).collect();
+    let tree = Octree::build(&shapes, OctreeParams::default()).unwrap();
+    let mut stack = super::WalkStack::default();
+    let (mut lanes, mut single) = (ShadowCrossings::default(), ShadowCrossings::default());
+    let (mut hits, mut crossed) = (0, 0);
+    for sides in [&[][..], &one_sided[..]] {
+        let prims = Primitives {
+            shapes: &shapes,
+            one_sided: sides,
+            transparent: &transparent,
+        };
+        for _ in 0..3000 {
+            let origin = DVec3::new(
+                random.unit() * 6.0 - 1.0,
+                random.unit() * 6.0 - 1.0,
+                random.unit() * 4.0 - 1.0,
+            );
+            // Aimed at a fan's hub (shared by twelve triangles) or anywhere.
+            let target =
+                match &shapes[(random.unit() * shapes.len() as f64) as usize % shapes.len()] {
+                    Shape::Triangle(t) => t.vertices[0],
+                    Shape::Sphere(s) => s.center,
+                    _ => DVec3::ZERO,
+                };
+            let Some(dir) = (target - origin).try_normalize() else {
+                continue;
+            };
+            let ray = PreparedRay::new(Ray::new(origin, dir));
+            let four =
+                tree.closest_inline(&prims, &ray, f64::INFINITY, &mut stack, &mut NoCounts, simd);
+            let one = tree.closest_inline(
+                &prims,
+                &ray,
+                f64::INFINITY,
+                &mut stack,
+                &mut NoCounts,
+                OneByOne(simd),
+            );
+            assert_eq!(four, one, "{:?}", ray.ray);
+            // The one-by-one levels' own four-at-once answer (which the
+            // walks never ask of them) is the lanes' too.
+            let picked: [&Triangle; 4] = std::array::from_fn(|_| {
+                triangles[(random.unit() * triangles.len() as f64) as usize % triangles.len()]
+            });
+            let (a, b) = (
+                simd.intersect_four(picked, 0b1111, &ray, 6.0),
+                Baseline.intersect_four(picked, 0b1111, &ray, 6.0),
+            );
+            assert_eq!(a.hit, b.hit);
+            for j in (0..4).filter(|j| a.hit >> j & 1 == 1) {
+                assert_eq!(a.t[j].to_bits(), b.t[j].to_bits());
+                assert_eq!((a.v[j] / a.det[j]).to_bits(), (b.v[j] / b.det[j]).to_bits());
+                assert_eq!((a.w[j] / a.det[j]).to_bits(), (b.w[j] / b.det[j]).to_bits());
+            }
+            hits += four.is_some() as usize;
+            let distance = 2.0 + 6.0 * random.unit();
+            tree.occlusion_inline(
+                &prims,
+                &ray,
+                distance,
+                &mut lanes,
+                &mut stack,
+                &mut NoCounts,
+                simd,
+            );
+            tree.occlusion_inline(
+                &prims,
+                &ray,
+                distance,
+                &mut single,
+                &mut stack,
+                &mut NoCounts,
+                OneByOne(simd),
+            );
+            assert_eq!(lanes, single, "{:?}", ray.ray);
+            crossed += lanes.transparent().len();
+            // A light buffer's list: the shapes in random order.
+            let list: Vec<u32> = (0..40)
+                .map(|_| (random.unit() * shapes.len() as f64) as u32 % shapes.len() as u32)
+                .collect();
+            occlusion_among_in_lanes(&prims, [&[], &list], &ray, distance, &mut lanes, simd);
+            occlusion_among(
+                &prims,
+                [&[], &list],
+                &ray,
+                distance,
+                &mut single,
+                &mut NoCounts,
+            );
+            assert_eq!(lanes, single, "{:?}", ray.ray);
+        }
+    }
+    assert!(
+        hits > 1000 && crossed > 1000,
+        "{hits} hits, {crossed} crossings"
+    );
+}
