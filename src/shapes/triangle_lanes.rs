@@ -29,14 +29,33 @@ pub trait TriangleLanes: Copy {
     const FOUR_AT_ONCE: bool;
 
     /// The lanes of `live` whose triangle `ray` hits with `0 < t < t_max`
-    /// (the other lanes may hold any triangle).
+    /// (the other lanes may hold any triangle). Unless a level says
+    /// otherwise, four single tests (barycentrics as quotients over 1,
+    /// which they equal).
     fn intersect_four(
         self,
         triangles: [&Triangle; 4],
         live: u32,
         ray: &PreparedRay,
         t_max: f64,
-    ) -> FourHits;
+    ) -> FourHits {
+        let mut four = FourHits {
+            hit: 0,
+            t: [0.0; 4],
+            v: [0.0; 4],
+            w: [1.0; 4],
+            det: [1.0; 4],
+        };
+        for (j, triangle) in triangles.iter().enumerate() {
+            if live >> j & 1 == 1
+                && let Some(hit) = triangle.intersect(ray, t_max)
+            {
+                (four.t[j], four.v[j], four.w[j]) = (hit.t, hit.b1, hit.b2);
+                four.hit |= 1 << j;
+            }
+        }
+        four
+    }
 }
 
 /// AVX2: the twelve vertices transposed into nine registers (two 4x4

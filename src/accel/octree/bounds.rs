@@ -13,7 +13,7 @@
 
 use super::node::{Cell, Node};
 use crate::math::Aabb;
-use crate::shapes::{FourHits, PreparedRay, Shape, Triangle, TriangleLanes};
+use crate::shapes::{PreparedRay, Shape, TriangleLanes};
 
 /// Lanes a node's children take: one per octant.
 pub(super) const WIDTH: usize = 8;
@@ -177,32 +177,6 @@ pub struct Baseline;
 /// Baseline tests triangles one by one.
 impl TriangleLanes for Baseline {
     const FOUR_AT_ONCE: bool = false;
-
-    fn intersect_four(
-        self,
-        triangles: [&Triangle; 4],
-        live: u32,
-        ray: &PreparedRay,
-        t_max: f64,
-    ) -> FourHits {
-        let mut four = FourHits {
-            hit: 0,
-            t: [0.0; 4],
-            v: [0.0; 4],
-            w: [1.0; 4],
-            det: [1.0; 4],
-        };
-        for (j, triangle) in triangles.iter().enumerate() {
-            if live >> j & 1 == 1
-                && let Some(hit) = triangle.intersect(ray, t_max)
-            {
-                // Barycentrics as quotients over 1, which they equal.
-                (four.t[j], four.v[j], four.w[j]) = (hit.t, hit.b1, hit.b2);
-                four.hit |= 1 << j;
-            }
-        }
-        four
-    }
 }
 
 /// Another level's boxes with triangles tested one by one: for scenes
@@ -214,16 +188,6 @@ pub(crate) struct OneByOne<L>(pub L);
 
 impl<L: BoxLanes> TriangleLanes for OneByOne<L> {
     const FOUR_AT_ONCE: bool = false;
-
-    fn intersect_four(
-        self,
-        triangles: [&Triangle; 4],
-        live: u32,
-        ray: &PreparedRay,
-        t_max: f64,
-    ) -> FourHits {
-        Baseline.intersect_four(triangles, live, ray, t_max)
-    }
 }
 
 impl<L: BoxLanes> BoxLanes for OneByOne<L> {
