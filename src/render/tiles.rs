@@ -1,6 +1,8 @@
 //! The image as tiles: the unit of parallel work and progress, and how
 //! their values are put back into a frame.
 
+use std::sync::Mutex;
+
 /// Square tile edge in pixels: the unit of parallel work and of progress.
 pub const TILE: u32 = 16;
 
@@ -60,6 +62,40 @@ pub fn corner_bands(height: u32) -> Vec<(u32, u32)> {
         .collect()
 }
 
+/// A frame's rows in bands of [`TILE`] rows, each behind a lock of its
+/// own, for the tiles [`tiles`] lists to be placed into as they finish: a
+/// tile lies in one band, and tiles of different bands never wait for each
+/// other (nor for the first writes to each other's memory).
+pub struct TileBands<'a, T> {
+    width: u32,
+    bands: Vec<Mutex<&'a mut [T]>>,
+}
+
+impl<'a, T: Copy> TileBands<'a, T> {
+    /// The bands of `frame`, `width` values a row.
+    pub fn new(frame: &'a mut [T], width: u32) -> Self {
+        let band = (width * TILE).max(1) as usize;
+        Self {
+            width,
+            bands: frame.chunks_mut(band).map(Mutex::new).collect(),
+        }
+    }
+
+    /// Copies `tile`'s row-major `values` into its place.
+    pub fn place(&self, tile: &Tile, values: &[T]) {
+        let Some(band) = self.bands.get((tile.y / TILE) as usize) else {
+            return;
+        };
+        // A tile that panicked mid-copy left other rows than this one's.
+        let mut band = band.lock().unwrap_or_else(|e| e.into_inner());
+        let within = Tile {
+            y: tile.y % TILE,
+            ..*tile
+        };
+        place_tile(&mut band, self.width, &within, values, 1);
+    }
+}
+
 /// Copies a tile's row-major values into a frame-sized buffer of
 /// `width`-pixel rows, `channels` values a pixel (1 for per-pixel values,
 /// 4 for RGBA bytes).
@@ -117,6 +153,31 @@ mod tests {
                 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 2, 2, 0, 0, 0, 0, 3, 3, 4, 4, 0, 0
             ]
         );
+    }
+
+    #[test]
+    fn tiles_placed_in_bands_are_the_tiles_placed_whole() {
+        for (width, height) in [(1, 1), (16, 16), (17, 3), (40, 20), (37, 33)] {
+            let all = tiles(width, height);
+            let values: Vec<Vec<u32>> = (0..all.len() as u32)
+                .map(|k| {
+                    (0..all[k as usize].pixels() as u32)
+                        .map(|p| k << 16 | p)
+                        .collect()
+                })
+                .collect();
+            let mut whole = vec![u32::MAX; (width * height) as usize];
+            for (t, v) in all.iter().zip(&values) {
+                place_tile(&mut whole, width, t, v, 1);
+            }
+            let mut banded = vec![u32::MAX; (width * height) as usize];
+            let bands = TileBands::new(&mut banded, width);
+            for (t, v) in all.iter().zip(&values).rev() {
+                bands.place(t, v);
+            }
+            assert_eq!(banded, whole, "{width}x{height}");
+            assert!(!whole.contains(&u32::MAX), "{width}x{height}");
+        }
     }
 
     #[test]
