@@ -10,6 +10,8 @@
 //! The idea is Whitted's own (1980: subdivide where neighbouring samples
 //! differ), here with the regular grid glint uses everywhere.
 
+use rayon::prelude::*;
+
 use crate::math::Color;
 use crate::render::ray_tree::{RayKind, RayRecorder};
 
@@ -61,7 +63,6 @@ impl RayRecorder for Signature {
 /// neighbourhood (clipped at the image's edge) holds another signature or
 /// a displayed value (`rgb`, 3 bytes a pixel) more than [`CONTRAST`] away.
 pub fn refine_mask(rgb: &[u8], signatures: &[u64], width: u32, height: u32) -> Vec<bool> {
-    use rayon::prelude::*;
     let (w, h) = (width as usize, height as usize);
     let differs = |a: usize, b: usize| {
         signatures[a] != signatures[b]
@@ -200,5 +201,11 @@ mod tests {
                 assert!(marked > 0 && marked < n, "{w}x{h}: {marked} marked");
             }
         }
+        // One column and one row, each with an edge across it.
+        let mut signatures = vec![0u64; 4];
+        signatures[2..].fill(1);
+        let line = [false, true, true, false];
+        assert_eq!(refine_mask(&[100; 12], &signatures, 1, 4), line);
+        assert_eq!(refine_mask(&[100; 12], &signatures, 4, 1), line);
     }
 }

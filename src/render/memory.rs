@@ -4,13 +4,13 @@ use crate::render::RenderError;
 use crate::settings::{AntiAliasing, RenderSettings, ViewMode};
 
 /// Memory a render of `settings` needs for its own buffers, in bytes: the
-/// frame (a `DVec3` a pixel, held twice while tiles are assembled), the
+/// frame (a `DVec3` a pixel; each tile's values are freed once copied in), the
 /// encoded picture (3 bytes a pixel, twice while a PNG is built), and the
 /// extra frames of adaptive anti-aliasing, the aa-need view and the SPD
 /// protocol's corners. The scene and its octree come on top.
 pub fn estimated_bytes(settings: &RenderSettings) -> u64 {
     let pixels = settings.width as u64 * settings.height as u64;
-    let mut per_pixel = 2 * 24 + 2 * 3;
+    let mut per_pixel = 24 + 2 * 3;
     if settings.anti_aliasing() == AntiAliasing::Adaptive {
         per_pixel += 24 + 8 + 1 + 3;
     }

@@ -486,8 +486,6 @@ impl Renderer<'_> {
         for tile_counts in per_tile {
             counts += tile_counts?;
         }
-        // The bands borrow the buffers.
-        drop((pixel_bands, signature_bands));
         Some((pixels, signatures, counts))
     }
 }

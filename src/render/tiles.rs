@@ -65,7 +65,7 @@ pub fn corner_bands(height: u32) -> Vec<(u32, u32)> {
 /// A frame's rows in bands of [`TILE`] rows, each behind a lock of its
 /// own, for the tiles [`tiles`] lists to be placed into as they finish: a
 /// tile lies in one band, and tiles of different bands never wait for each
-/// other (nor for the first writes to each other's memory).
+/// other.
 pub struct TileBands<'a, T> {
     width: u32,
     bands: Vec<Mutex<&'a mut [T]>>,
@@ -83,11 +83,11 @@ impl<'a, T: Copy> TileBands<'a, T> {
 
     /// Copies `tile`'s row-major `values` into its place.
     pub fn place(&self, tile: &Tile, values: &[T]) {
-        let Some(band) = self.bands.get((tile.y / TILE) as usize) else {
-            return;
-        };
-        // A tile that panicked mid-copy left other rows than this one's.
-        let mut band = band.lock().unwrap_or_else(|e| e.into_inner());
+        // A tile that panicked while copying wrote only its own columns;
+        // the pass fails anyway, and the others need not panic as well.
+        let mut band = self.bands[(tile.y / TILE) as usize]
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
         let within = Tile {
             y: tile.y % TILE,
             ..*tile

@@ -289,7 +289,7 @@ fn limits_are_stated_when_refused() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("8192x8192 render needs about 3456 MiB") && e.contains("819 MiB"),
+        e.contains("8192x8192 render needs about 1920 MiB") && e.contains("819 MiB"),
         "{e}"
     );
     (settings.width, settings.height) = (1024, 1024);
