@@ -108,18 +108,15 @@ pub fn refine_mask(rgb: &[u8], signatures: &[u64], width: u32, height: u32) -> V
         .for_each(|(y, row)| {
             for (x, marked) in row.iter_mut().enumerate() {
                 let a = y * w + x;
-                let above = |dx: isize, bit: u8| {
-                    let nx = x as isize + dx;
-                    y > 0
-                        && nx >= 0
-                        && (nx as usize) < w
-                        && pairs[a - w - x + nx as usize] & bit != 0
+                // The pair `bit` that pixel `nx` of the row above holds.
+                let above = |nx: Option<usize>, bit: u8| {
+                    y > 0 && nx.is_some_and(|nx| nx < w && pairs[(y - 1) * w + nx] & bit != 0)
                 };
                 *marked = pairs[a] != 0
                     || (x > 0 && pairs[a - 1] & RIGHT != 0)
-                    || above(0, DOWN)
-                    || above(-1, DOWN_RIGHT)
-                    || above(1, DOWN_LEFT);
+                    || above(Some(x), DOWN)
+                    || above(x.checked_sub(1), DOWN_RIGHT)
+                    || above(Some(x + 1), DOWN_LEFT);
             }
         });
     mask
