@@ -191,9 +191,8 @@ fuzz_target!(|input: Input| {
 
     let transparent: Vec<bool> = shape_materials.iter().map(|&m| m == 2).collect();
     let prims = Primitives {
-        shapes: &shapes,
-        one_sided: &[],
         transparent: &transparent,
+        ..Primitives::opaque(&shapes)
     };
     let shadow_length = units.length(input.shadow_length).max(f64::MIN_POSITIVE);
     let mut stack = WalkStack::default();

@@ -5,17 +5,19 @@
 mod bvh;
 mod light_buffer;
 mod octree;
+mod planes;
 mod primitives;
 mod walk_log;
 
 pub use crate::stats::walk_record::{CellVisit, QueryRecord, StepKind, Tested, WalkEnd, WalkStep};
 pub use bvh::{Bvh, BvhStack, BvhStats};
 pub use light_buffer::{Candidates, LightBuffer, LightBufferStats};
-pub(crate) use octree::OneByOne;
 pub use octree::{
     Baseline, BoxLanes, DEFAULT_MEMORY_BUDGET_MIB, Octree, OctreeCell, OctreeError, OctreeParams,
     OctreeStats, PacketStack, PredictedCost, WalkStack,
 };
+pub(crate) use octree::{OneByOne, SkippingPlanes};
+pub use planes::{PlaneGroups, ShapeRange};
 pub(crate) use primitives::occlusion_among_in_lanes;
 pub use primitives::{
     ClosestHit, MAX_SHADOW_CROSSINGS, Primitives, ShadowCrossings, closest_brute_force,

@@ -20,6 +20,9 @@ pub struct Primitives<'a> {
     /// Shapes that let light through: shadow rays record their crossings
     /// instead of stopping. Empty when none does.
     pub transparent: &'a [bool],
+    /// The shapes in the plane the ray leaves ([`crate::accel::PlaneGroups`]):
+    /// it cannot meet them, so uncounted queries skip them.
+    pub left_behind: super::planes::ShapeRange,
 }
 
 impl<'a> Primitives<'a> {
@@ -29,6 +32,7 @@ impl<'a> Primitives<'a> {
             shapes,
             one_sided: &[],
             transparent: &[],
+            left_behind: super::planes::ShapeRange::EMPTY,
         }
     }
 
@@ -90,6 +94,13 @@ impl<'a> Primitives<'a> {
             }
             _ => None,
         }
+    }
+
+    /// Whether shape `index` lies in the plane group the ray leaves
+    /// behind: then the ray cannot meet it.
+    #[inline(always)]
+    pub(crate) fn left_behind(&self, index: u32) -> bool {
+        self.left_behind.contains(index)
     }
 
     #[inline(always)]
@@ -495,9 +506,27 @@ pub fn occlusion_among<C: Counter>(
     found: &mut ShadowCrossings,
     counter: &mut C,
 ) {
+    occlusion_among_skipping(prims, lists, ray, t_max, found, counter, false);
+}
+
+/// [`occlusion_among`], skipping the shapes the ray leaves behind if
+/// `skipping` (a constant where it is inlined).
+#[inline(always)]
+fn occlusion_among_skipping<C: Counter>(
+    prims: &Primitives,
+    lists: [&[u32]; 2],
+    ray: &PreparedRay,
+    t_max: f64,
+    found: &mut ShadowCrossings,
+    counter: &mut C,
+    skipping: bool,
+) {
     found.clear();
     for list in lists {
         for &i in list {
+            if skipping && prims.left_behind(i) {
+                continue;
+            }
             if test_occlusion(prims, i, ray, t_max, found, counter) {
                 return;
             }
@@ -519,13 +548,17 @@ pub(crate) fn occlusion_among_in_lanes<L: TriangleLanes>(
     // Most lists are short (one or two shapes on the default scene): they
     // go as they went.
     if !(L::FOUR_AT_ONCE && lists[1].len() >= 4) {
-        occlusion_among(prims, lists, ray, t_max, found, &mut crate::stats::NoCounts);
+        let counter = &mut crate::stats::NoCounts;
+        occlusion_among_skipping(prims, lists, ray, t_max, found, counter, L::SKIPS_PLANES);
         return;
     }
     found.clear();
     let mut batch = TriangleBatch::new();
     for list in lists {
         for &i in list {
+            if L::SKIPS_PLANES && prims.left_behind(i) {
+                continue;
+            }
             let blocked = if let Some((triangle, transparent)) = prims.shadow_triangle(i) {
                 batch.push(i, triangle, transparent)
                     && batch.blocks(prims, ray, t_max, found, lanes)

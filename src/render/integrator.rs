@@ -28,6 +28,8 @@ pub(super) struct ShadingPoint {
     normal: DVec3,
     /// Whether the ray meets the surface from outside.
     entering: bool,
+    /// The shape hit.
+    pub(super) shape: u32,
     material: u32,
     /// The diffuse colour here: the material's, or the vertex colours
     /// interpolated across a triangle that has them.
@@ -142,6 +144,7 @@ impl Renderer<'_> {
             entering,
         });
         ShadingPoint {
+            shape: hit.shape,
             point,
             shadow_point,
             smooth,
@@ -174,7 +177,8 @@ impl Renderer<'_> {
             let pass = if self.settings.shadows {
                 rays.shadow += 1;
                 let shadow = PreparedRay::new(Ray::new(shadow_origin, l));
-                self.transmittance(&shadow, distance, index, query)
+                let left = self.left_behind(at.shape, shadow_origin, l);
+                self.transmittance(&shadow, distance, index, left, query)
             } else {
                 1.0
             };

@@ -434,9 +434,11 @@ impl Renderer<'_> {
         // function's SIMD level, and calling them cost the default scene a
         // third more time at 1 spp (2026-11-28).
         let mut origins = [DVec3::ZERO; N];
+        let mut shapes = [0; N];
         for k in 0..n {
             if let Some(at) = &points[k] {
                 origins[k] = self.shadow_origin(at);
+                shapes[k] = at.shape;
             }
         }
         for (index, light) in self.scene.lights.iter().enumerate() {
@@ -447,7 +449,7 @@ impl Renderer<'_> {
                 }
             }
             let passes = if self.settings.shadows {
-                self.transmittance_lanes(&origins, &toward, index, query, ray_counts)
+                self.transmittance_lanes(&origins, &shapes, &toward, index, query, ray_counts)
             } else {
                 [1.0; N]
             };
@@ -591,6 +593,7 @@ impl Renderer<'_> {
     fn transmittance_lanes<C: Counter, const N: usize>(
         &self,
         origins: &[DVec3; N],
+        shapes: &[u32; N],
         toward: &[Option<(DVec3, f64, f64)>; N],
         light: usize,
         query: &mut Query<C>,
@@ -601,7 +604,8 @@ impl Renderer<'_> {
             if let Some((l, distance, _)) = toward[k] {
                 ray_counts.shadow += 1;
                 let ray = PreparedRay::new(Ray::new(origins[k], l));
-                passes[k] = self.transmittance(&ray, distance, light, query);
+                let left = self.left_behind(shapes[k], origins[k], l);
+                passes[k] = self.transmittance(&ray, distance, light, left, query);
             }
         }
         passes

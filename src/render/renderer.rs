@@ -5,13 +5,13 @@
 
 use crate::accel::{
     BoxLanes, Bvh, BvhStack, Candidates, ClosestHit, LightBuffer, Octree, OneByOne, Primitives,
-    ShadowCrossings, WalkLog, WalkStack, closest_brute_force, occlusion_among,
-    occlusion_among_in_lanes, occlusion_brute_force,
+    ShadowCrossings, ShapeRange, SkippingPlanes, WalkLog, WalkStack, closest_brute_force,
+    occlusion_among, occlusion_among_in_lanes, occlusion_brute_force,
 };
 use crate::camera::{Camera, CameraError, CameraSpec, sample_offsets};
 use crate::limits::LimitError;
 use crate::material::Material;
-use crate::math::Color;
+use crate::math::{Color, DVec3};
 use crate::render::ray_tree::{RayKind, RayNode};
 use crate::scene::Scene;
 use crate::settings::{Accel, RenderSettings, Sides, ViewMode};
@@ -300,6 +300,10 @@ pub struct Renderer<'a> {
     /// Single rays test triangles four at a time
     /// ([`Primitives::mostly_triangles`]).
     triangle_lanes: bool,
+    /// Shadow rays skip the shapes in the plane they leave: where single
+    /// rays test triangles four at a time and the scene has shapes that
+    /// share a plane ([`crate::accel::PlaneGroups`]).
+    skips_planes: bool,
     /// The scene's materials and background as this render shades them
     /// (decoded into linear light for a linear render of display values).
     pub(super) materials: Vec<Material>,
@@ -390,6 +394,8 @@ impl<'a> Renderer<'a> {
             routes: Routes::new(&settings, octree, false),
             shadow_hints: scene.shapes.len() > HINTS_MIN_SHAPES,
             triangle_lanes: Primitives::mostly_triangles(&scene.shapes),
+            skips_planes: Primitives::mostly_triangles(&scene.shapes)
+                && octree.planes().has_groups(),
             light_buffer: None,
             settings,
             camera,
@@ -515,6 +521,29 @@ impl<'a> Renderer<'a> {
             shapes: &self.scene.shapes,
             one_sided: &self.one_sided,
             transparent: &self.is_transparent,
+            left_behind: ShapeRange::EMPTY,
+        }
+    }
+
+    /// The shapes a shadow ray from `origin` along `dir`, leaving a hit on
+    /// shape `shape`, skips ([`crate::accel::PlaneGroups::left_behind`]).
+    #[inline(always)]
+    pub(super) fn left_behind(&self, shape: u32, origin: DVec3, dir: DVec3) -> ShapeRange {
+        if self.skips_planes {
+            self.octree.planes().left_behind(shape, origin, dir)
+        } else {
+            ShapeRange::EMPTY
+        }
+    }
+
+    /// [`Renderer::single`] for a shadow ray's `query`: skipping the shapes
+    /// in the plane the ray leaves where the renderer does.
+    #[inline(always)]
+    fn single_shadow<Q: SingleQuery>(&self, simd: pulp::x86::V3, query: Q) -> Q::Output {
+        if self.skips_planes {
+            pulp::Simd::vectorize(simd, InLanes(query, SkippingPlanes(simd)))
+        } else {
+            self.single(simd, query)
         }
     }
 
@@ -598,9 +627,11 @@ impl<'a> Renderer<'a> {
         ray: &PreparedRay,
         distance: f64,
         light: usize,
+        left_behind: ShapeRange,
         query: &mut Query<C>,
     ) -> f64 {
-        let prims = self.primitives();
+        let mut prims = self.primitives();
+        prims.left_behind = left_behind;
         let Scratch {
             stack,
             bvh,
@@ -632,7 +663,7 @@ impl<'a> Renderer<'a> {
         };
         if let Some(lists) = few {
             match self.single_rays.avx2() {
-                Some(simd) => self.single(
+                Some(simd) => self.single_shadow(
                     simd,
                     AmongQuery {
                         prims: &prims,
@@ -663,7 +694,7 @@ impl<'a> Renderer<'a> {
             }
         } else if route == Route::Octree {
             match self.single_rays.avx2() {
-                Some(simd) if !C::COUNTS => self.single(
+                Some(simd) if !C::COUNTS => self.single_shadow(
                     simd,
                     OcclusionQuery {
                         octree: self.octree,

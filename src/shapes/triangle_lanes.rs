@@ -28,6 +28,11 @@ pub trait TriangleLanes: Copy {
     /// one as before.
     const FOUR_AT_ONCE: bool;
 
+    /// Whether shadow rays skip the shapes in the plane they leave
+    /// ([`crate::accel::PlaneGroups`]): a copy of the walk of its own for
+    /// scenes that have such groups, so that the others pay nothing.
+    const SKIPS_PLANES: bool = false;
+
     /// The lanes of `live` whose triangle `ray` hits with `0 < t < t_max`
     /// (the other lanes may hold any triangle). Unless a level says
     /// otherwise, four single tests (barycentrics as quotients over 1,

@@ -149,7 +149,7 @@ proptest! {
         let is_transparent: Vec<bool> = (0..shapes.len()).map(|i| transparent_mask >> (i % 64) & 1 == 1).collect();
         // Some shapes one-sided (the SPD protocol's opaque surfaces).
         let one_sided: Vec<bool> = (0..shapes.len()).map(|i| one_sided_mask >> (i % 64) & 1 == 1).collect();
-        let prims = Primitives { shapes: &shapes, one_sided: &one_sided, transparent: &is_transparent };
+        let prims = Primitives { one_sided: &one_sided, transparent: &is_transparent, ..Primitives::opaque(&shapes) };
         for ray in rays {
             agree(&octree, &bvh, &prims, ray, shadow_length)?;
         }
@@ -173,7 +173,7 @@ proptest! {
         let octree = Octree::build(&shapes, OctreeParams { leaf_size, ..Default::default() }).unwrap();
         let bvh = Bvh::build(&shapes);
         let is_transparent: Vec<bool> = (0..shapes.len()).map(|i| transparent_mask >> (i % 64) & 1 == 1).collect();
-        let prims = Primitives { shapes: &shapes, one_sided: &[], transparent: &is_transparent };
+        let prims = Primitives { transparent: &is_transparent, ..Primitives::opaque(&shapes) };
         for (ray, on, u, v) in rays {
             let origin = ray.origin * scale + DVec3::splat(offset);
             let ray = match &shapes[on % shapes.len()] {

@@ -50,6 +50,7 @@ fn check(shapes: &[Shape], lights: &[DVec3], transparent: &[bool], rays: usize) 
         shapes,
         one_sided: &[],
         transparent,
+        left_behind: crate::accel::ShapeRange::EMPTY,
     };
     let bounds = shapes
         .iter()

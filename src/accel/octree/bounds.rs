@@ -197,6 +197,34 @@ impl<L: BoxLanes> BoxLanes for OneByOne<L> {
     }
 }
 
+/// Another level's lanes, with shadow rays skipping the shapes in the
+/// plane they leave ([`TriangleLanes::SKIPS_PLANES`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SkippingPlanes<L>(pub L);
+
+impl<L: BoxLanes> TriangleLanes for SkippingPlanes<L> {
+    const FOUR_AT_ONCE: bool = L::FOUR_AT_ONCE;
+    const SKIPS_PLANES: bool = true;
+
+    #[inline(always)]
+    fn intersect_four(
+        self,
+        triangles: [&crate::shapes::Triangle; 4],
+        live: u32,
+        ray: &crate::shapes::PreparedRay,
+        t_max: f64,
+    ) -> crate::shapes::FourHits {
+        self.0.intersect_four(triangles, live, ray, t_max)
+    }
+}
+
+impl<L: BoxLanes> BoxLanes for SkippingPlanes<L> {
+    #[inline(always)]
+    fn hit(self, block: &Block, count: u32, ray: &BoxRay, limit: f32) -> (u32, [f32; WIDTH]) {
+        self.0.hit(block, count, ray, limit)
+    }
+}
+
 impl BoxLanes for Baseline {
     #[inline(always)]
     fn hit(self, block: &Block, count: u32, ray: &BoxRay, limit: f32) -> (u32, [f32; WIDTH]) {

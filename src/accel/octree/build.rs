@@ -92,6 +92,7 @@ impl Octree {
             },
             sides: [0.0; LEVEL_MASK + 1],
             boxes: NodeBoxes::default(),
+            planes: crate::accel::planes::PlaneGroups::build(shapes),
         };
         if bounded.is_empty() {
             return Ok(tree);

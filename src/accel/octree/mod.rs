@@ -40,8 +40,8 @@ mod visit;
 mod walk;
 mod wide_walk;
 
-pub(crate) use bounds::OneByOne;
 pub use bounds::{Baseline, BoxLanes};
+pub(crate) use bounds::{OneByOne, SkippingPlanes};
 pub use packet_walk::PacketStack;
 pub use params::{DEFAULT_MEMORY_BUDGET_MIB, OctreeCell, OctreeError, OctreeParams, OctreeStats};
 pub use predict::PredictedCost;

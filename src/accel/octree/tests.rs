@@ -531,6 +531,7 @@ fn triangles_four_at_a_time_answer_as_one_by_one() {
             shapes: &shapes,
             one_sided: sides,
             transparent: &transparent,
+            left_behind: crate::accel::ShapeRange::EMPTY,
         };
         for _ in 0..3000 {
             let origin = DVec3::new(

@@ -22,6 +22,8 @@ pub struct Octree {
     pub(super) sides: [f64; LEVEL_MASK + 1],
     /// The box of what each stored node holds, for the wide walk.
     pub(super) boxes: NodeBoxes,
+    /// The shapes grouped by the plane they lie in, for rays leaving one.
+    pub(super) planes: crate::accel::planes::PlaneGroups,
 }
 
 impl Octree {
@@ -35,6 +37,11 @@ impl Octree {
 
     pub fn bounds(&self) -> Aabb {
         self.bounds
+    }
+
+    /// The shapes grouped by the plane they lie in.
+    pub fn planes(&self) -> &crate::accel::planes::PlaneGroups {
+        &self.planes
     }
 
     /// Whether the whole tree is one leaf (a scene of a few shapes, or a

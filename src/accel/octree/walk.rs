@@ -414,7 +414,7 @@ impl<C: Counter> LeafVisitor for OcclusionVisitor<'_, C> {
         let batching = !C::COUNTS && L::FOUR_AT_ONCE;
         let mut batch = TriangleBatch::new();
         for &i in refs {
-            if self.mailbox.seen(i) {
+            if (L::SKIPS_PLANES && self.prims.left_behind(i)) || self.mailbox.seen(i) {
                 continue;
             }
             let blocked =

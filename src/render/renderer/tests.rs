@@ -74,7 +74,13 @@ fn shadow_hints_change_no_answer() {
                 counter: &mut NoCounts,
                 scratch: &mut scratch,
             };
-            let pass = renderer.transmittance(&ray, distance, light, &mut query);
+            let pass = renderer.transmittance(
+                &ray,
+                distance,
+                light,
+                crate::accel::ShapeRange::EMPTY,
+                &mut query,
+            );
             let mut crossings = ShadowCrossings::default();
             occlusion_brute_force(
                 &renderer.primitives(),
@@ -140,7 +146,13 @@ fn the_light_buffer_changes_no_answer() {
                 counter: &mut NoCounts,
                 scratch,
             };
-            renderer.transmittance(&ray, to_light.length(), light, &mut query)
+            renderer.transmittance(
+                &ray,
+                to_light.length(),
+                light,
+                crate::accel::ShapeRange::EMPTY,
+                &mut query,
+            )
         };
         let expected = pass(&plain, &mut plain_scratch);
         assert_eq!(
@@ -194,5 +206,85 @@ fn a_one_leaf_tree_sends_only_counted_queries_through_the_octree() {
             .unwrap()
             .with_bvh(&bvh);
         assert_eq!(routes(&brute), (BruteForce, BruteForce, false, false));
+    }
+}
+
+/// Stacked 60-gons cut into slivers, glass and opaque, over a floor of
+/// slivers, lit from grazing angles, near the origin and a million away:
+/// shadow rays that skip the shapes in the plane they leave give the
+/// pictures brute force gives, byte for byte.
+#[test]
+fn shadow_rays_skipping_their_plane_change_no_picture() {
+    for far in [0.0, 1e6] {
+        let at = DVec3::splat(far);
+        let fan = |center: DVec3, normal: DVec3, radius: f64| {
+            let (u, w) = crate::math::orthonormal_basis(normal.normalize());
+            let vertex = |k: usize| {
+                let angle = std::f64::consts::TAU * k as f64 / 60.0;
+                at + center + radius * (angle.cos() * u + angle.sin() * w)
+            };
+            (1..59)
+                .filter_map(|k| crate::shapes::Triangle::new([vertex(0), vertex(k), vertex(k + 1)]))
+                .map(crate::shapes::Shape::Triangle)
+                .collect::<Vec<_>>()
+        };
+        let mut shapes = fan(DVec3::new(0.0, -1.0, 0.0), DVec3::Y, 4.0);
+        for k in 0..6 {
+            let tilt = DVec3::new(0.02 * k as f64, 1.0, -0.01 * k as f64);
+            shapes.extend(fan(
+                DVec3::new(0.1 * k as f64, 0.3 * k as f64, 0.0),
+                tilt,
+                1.5,
+            ));
+        }
+        let count = shapes.len();
+        let mut scene = scene_of(shapes);
+        scene.camera.eye = at + DVec3::new(0.0, 4.0, 9.0);
+        scene.camera.lookat = at;
+        scene.materials.push(Material {
+            transparency: 0.7,
+            ior: 1.3,
+            ..Material::default()
+        });
+        // Every other disc glass, the floor opaque.
+        let materials: Vec<u32> = (0..count).map(|i| ((i / 58) % 2 == 1) as u32).collect();
+        scene.shape_materials = std::sync::Arc::new(materials);
+        let light = |x, y, z| crate::material::Light {
+            position: at + DVec3::new(x, y, z),
+            color: DVec3::splat(0.5),
+        };
+        scene.lights = vec![
+            light(6.0, 0.05, 1.0),
+            light(-3.0, 5.0, 2.0),
+            light(0.5, 1.62, -4.0),
+        ];
+        let octree = scene.build_octree().unwrap();
+        let buffer = scene.build_light_buffer();
+        let mut settings = scene.render_settings();
+        (settings.width, settings.height, settings.samples) = (96, 72, 1);
+        let skipping = Renderer::new(&scene, &octree, settings)
+            .unwrap()
+            .with_light_buffer(buffer.as_ref());
+        let walking = Renderer::new(&scene, &octree, settings).unwrap();
+        assert!(skipping.skips_planes && walking.skips_planes);
+        let brute = Renderer::new(
+            &scene,
+            &octree,
+            RenderSettings {
+                use_octree: false,
+                ..settings
+            },
+        )
+        .unwrap();
+        let picture = |r: &Renderer| r.render(false, None).0.to_rgb8();
+        let expected = picture(&brute);
+        assert!(
+            picture(&skipping) == expected,
+            "far {far}: through the light buffer"
+        );
+        assert!(
+            picture(&walking) == expected,
+            "far {far}: through the octree"
+        );
     }
 }
