@@ -185,8 +185,8 @@ mod tests {
     use crate::shapes::{Plane, PreparedRay, Sphere, Triangle};
 
     /// An `n`-gon of radius `radius` about `center` in the plane of unit
-    /// `normal`, cut into a fan of slivers from its first vertex, as a
-    /// polygon of a scene file is.
+    /// `normal`, cut into a fan of slivers from its first vertex: its
+    /// triangles consecutive, as a scene file's polygon's are.
     fn fan(center: DVec3, normal: DVec3, radius: f64, n: usize) -> Vec<Shape> {
         let (u, w) = crate::math::orthonormal_basis(normal);
         let vertex = |k: usize| {
