@@ -113,11 +113,12 @@ impl PlaneGroups {
                 }
             }
             groups.close(open.take(), shapes.len());
-            let [a, b, c] = t.vertices;
-            let normal = (b - a).cross(c - a).normalize_or_zero();
+            // (A triangle too thin for a finite normal gets a NaN slack
+            // and is never skipped.)
+            let normal = t.normal();
             let mut plane = GroupPlane {
                 normal,
-                offset: normal.dot(a),
+                offset: normal.dot(t.vertices[0]),
                 slack: 0.0,
                 shapes: ShapeRange {
                     first: index as u32,

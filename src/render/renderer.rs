@@ -387,15 +387,15 @@ impl<'a> Renderer<'a> {
                 ..m.clone()
             })
             .collect();
+        let triangle_lanes = Primitives::mostly_triangles(&scene.shapes);
         Ok(Self {
             scene,
             octree,
             bvh: None,
             routes: Routes::new(&settings, octree, false),
             shadow_hints: scene.shapes.len() > HINTS_MIN_SHAPES,
-            triangle_lanes: Primitives::mostly_triangles(&scene.shapes),
-            skips_planes: Primitives::mostly_triangles(&scene.shapes)
-                && octree.planes().has_groups(),
+            triangle_lanes,
+            skips_planes: triangle_lanes && octree.planes().has_groups(),
             light_buffer: None,
             settings,
             camera,
