@@ -137,6 +137,10 @@ pub(super) trait LeafVisitor: Visitor<Limit = f64> {
     /// cell starts beyond the limit.
     const STOPPED: WalkEnd;
     const BEYOND_LIMIT: WalkEnd;
+    /// Whether the wide walk must enter the children it meets nearest
+    /// first. A closest-hit query must, to cut off what lies beyond its
+    /// best hit; a shadow ray's answer does not depend on the order.
+    const NEAREST_FIRST: bool = true;
 }
 
 #[cfg(test)]

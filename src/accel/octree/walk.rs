@@ -404,6 +404,9 @@ impl<C: Counter> Visitor for OcclusionVisitor<'_, C> {
 
 impl<C: Counter> LeafVisitor for OcclusionVisitor<'_, C> {
     const STOPPED: WalkEnd = WalkEnd::Blocked;
+    // Any blocker ends the walk, and the crossings are kept sorted
+    // whatever order they are found in.
+    const NEAREST_FIRST: bool = false;
     const BEYOND_LIMIT: WalkEnd = WalkEnd::CellsBeyondLight;
 
     #[inline(always)]

@@ -69,6 +69,7 @@ impl Octree {
             entry: entry[0],
         };
         let mut top = 1usize;
+        let upward = ray.negative & 0b100 == 0;
         while top > 0 {
             top -= 1;
             let waiting = entries[top & (CAPACITY - 1)];
@@ -102,6 +103,35 @@ impl Octree {
                 if hits & (hits - 1) == 0 {
                     // One child: enter it without the stack.
                     index = first + hits.trailing_zeros();
+                    continue;
+                }
+                if !V::NEAREST_FIRST {
+                    // Unsorted, the far side along z first: children are
+                    // stored by octant, z's bit the highest. The cells near a
+                    // shadow ray's origin hold the surface it leaves and its
+                    // neighbours, which seldom block it; a blocker found
+                    // sooner ends the walk sooner (docs/notes/experiments.md).
+                    // One child is entered next, the others wait.
+                    let next = if upward {
+                        31 - hits.leading_zeros()
+                    } else {
+                        hits.trailing_zeros()
+                    };
+                    hits &= !(1 << next);
+                    while hits != 0 {
+                        let j = if upward {
+                            hits.trailing_zeros()
+                        } else {
+                            31 - hits.leading_zeros()
+                        };
+                        hits &= !(1 << j);
+                        entries[top & (CAPACITY - 1)] = Waiting {
+                            node: first + j,
+                            entry: entry[j as usize],
+                        };
+                        top += 1;
+                    }
+                    index = first + next;
                     continue;
                 }
                 // Every child met, kept sorted farthest first above the
