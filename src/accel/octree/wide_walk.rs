@@ -1,9 +1,10 @@
 //! The single-ray walk when nothing is counted: a node's children are
 //! tested eight at once against the boxes of what they hold
 //! (`bounds.rs`), as a BVH with eight-wide nodes is (Embree; Wald et al.
-//! 2008, "Getting Rid of Packets"), and the children the ray meets are
-//! visited nearest entry first. A cell whose box starts beyond the best
-//! hit so far is skipped. The answer is the exact walk's (`walk.rs`):
+//! 2008, "Getting Rid of Packets"), and the children a closest-hit ray
+//! meets are visited nearest entry first; a cell whose box starts beyond
+//! the best hit so far is skipped. A shadow ray's are visited unsorted,
+//! the far side along z first (its answer does not depend on the order). The answer is the exact walk's (`walk.rs`):
 //! every shape that could hold the closest hit or block the light is
 //! tested, in `f64`, and the closest hit is the lexicographic minimum of
 //! `(t, shape index)` whatever the order of the tests. Havran's measures
