@@ -137,9 +137,11 @@ pub(super) trait LeafVisitor: Visitor<Limit = f64> {
     /// cell starts beyond the limit.
     const STOPPED: WalkEnd;
     const BEYOND_LIMIT: WalkEnd;
-    /// Whether the wide walk must enter the children it meets nearest
-    /// first. A closest-hit query must, to cut off what lies beyond its
-    /// best hit; a shadow ray's answer does not depend on the order.
+    /// Whether the wide walk enters the children it meets nearest first.
+    /// Either way the answer is the same (a child entered past the limit
+    /// is skipped, and a shadow ray's answer does not depend on the
+    /// order); a closest-hit query finds its best hit sooner so, and cuts
+    /// off more of what lies beyond it.
     const NEAREST_FIRST: bool = true;
 }
 
