@@ -5,9 +5,10 @@
 //! meets are visited nearest entry first; a cell whose box starts beyond
 //! the best hit so far is skipped. A shadow ray's are visited in a fixed
 //! order, the far side along z first. Any order gives the same answer,
-//! the exact walk's (`walk.rs`): every shape that could hold the closest hit or block the light is
-//! tested, in `f64`, and the closest hit is the lexicographic minimum of
-//! `(t, shape index)` whatever the order of the tests. Havran's measures
+//! the exact walk's (`walk.rs`): every shape that could hold the closest
+//! hit or block the light is tested, in `f64`, and the closest hit is the
+//! lexicographic minimum of `(t, shape index)` whatever the order of the
+//! tests. Havran's measures
 //! count the exact walk's cells, so a counted query takes that walk.
 
 use super::bounds::{BoxLanes, BoxRay, limit_f32};
