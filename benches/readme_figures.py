@@ -238,6 +238,14 @@ def kernels():
     return "\n".join(lines) + f"\n\n{stamp('kernels')}"
 
 
+def secondary_steps():
+    """Instructions per ray at each step of issue 37, built from git
+    (benches/step_history.py; about 30 minutes)."""
+    import step_history
+
+    return f"{step_history.table(GLINT)}\n\n{stamp('secondary-steps')}"
+
+
 # Workloads that live on single rays (shadow rays, glass and mirrors), with
 # instructions per ray measured before issue 37's wide walk (history).
 SINGLE_RAY_WORKLOADS = [
@@ -537,6 +545,7 @@ SECTIONS = {
     "scaling": scaling,
     "peers": peers,
     "kernels": kernels,
+    "secondary-steps": secondary_steps,
     "adaptive": adaptive,
     "cost-view": cost_view,
     "study": study,
