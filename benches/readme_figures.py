@@ -3,7 +3,7 @@
 into the file that holds it.
 
     cargo build --release
-    python3 benches/readme_figures.py              # every section (about 40 minutes on 2 cores)
+    python3 benches/readme_figures.py              # every section (about an hour on 2 cores)
     python3 benches/readme_figures.py spd-table    # one or more sections
     python3 benches/readme_figures.py --list       # the sections, their files and what they measure
     python3 benches/readme_figures.py --reuse-sweep prediction
@@ -240,7 +240,7 @@ def kernels():
 
 def secondary_steps():
     """Instructions per ray at each step of issue 37, built from git
-    (benches/step_history.py; about 30 minutes)."""
+    (benches/step_history.py; about 20 minutes)."""
     import step_history
 
     return f"{step_history.table(GLINT)}\n\n{stamp('secondary-steps')}"

@@ -5,7 +5,7 @@
 Each commit's headless binary is built in a temporary git worktree into
 target/history (kept, so a second run builds nothing; about 4 minutes the
 first time on 2 cores), then every workload is counted by cachegrind for
-every binary, two at a time: about 25 minutes on 2 cores. The counts do not
+every binary, two at a time: about 15 minutes on 2 cores. The counts do not
 depend on the machine's load, so the binaries need not run interleaved.
 Standard library only; needs git, cargo and valgrind.
 """
