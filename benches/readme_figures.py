@@ -177,17 +177,19 @@ def peers():
     return f"{table}\n\n{stamp('peers')}"
 
 
-def instructions(args, width, height, env=None):
+def instructions(args, width, height, env=None, binary=GLINT):
     """Instructions per ray: cachegrind at the working size minus the same
     at 1x1 (loading and the octree build), over the render's rays. `env`
-    adds environment variables (GLINT_PACKETS=off: every ray single)."""
+    adds environment variables (GLINT_PACKETS=off: every ray single);
+    `binary` is the glint that renders (another commit's, for the step
+    table)."""
     env = {**os.environ, "GLINT_SIMD": "avx2", **(env or {})}
 
     def count(w, h):
         with tempfile.TemporaryDirectory() as d:
             out = os.path.join(d, "cg.out")
             run(["valgrind", "--tool=cachegrind", "--cache-sim=no", f"--cachegrind-out-file={out}",
-                 GLINT, "render", *args, "-o", os.path.join(d, "x.png"), "--width", str(w),
+                 binary, "render", *args, "-o", os.path.join(d, "x.png"), "--width", str(w),
                  "--height", str(h), "--threads", "1", "-q"],
                 env=env, stderr=subprocess.DEVNULL)
             with open(out) as f:
@@ -196,9 +198,9 @@ def instructions(args, width, height, env=None):
                         return int(line.split()[1])
         sys.exit("readme_figures: no cachegrind summary")
     with tempfile.TemporaryDirectory() as d:
-        stats = json.loads(glint("render", *args, "-o", os.path.join(d, "x.png"), "--width",
-                                 str(width), "--height", str(height), "--threads", "1",
-                                 "--stats", "-q"))
+        stats = json.loads(run([binary, "render", *args, "-o", os.path.join(d, "x.png"),
+                                "--width", str(width), "--height", str(height),
+                                "--threads", "1", "--stats", "-q"], env=env))
     return (count(width, height) - count(1, 1)) / stats["rays"]["total"]
 
 
@@ -243,7 +245,7 @@ def secondary_steps():
     (benches/step_history.py; about 20 minutes)."""
     import step_history
 
-    return f"{step_history.table(GLINT)}\n\n{stamp('secondary-steps')}"
+    return f"{step_history.table(GLINT, instructions)}\n\n{stamp('secondary-steps')}"
 
 
 # Workloads that live on single rays (shadow rays, glass and mirrors), with

@@ -10,7 +10,6 @@ depend on the machine's load, so the binaries need not run interleaved.
 Standard library only; needs git, cargo and valgrind.
 """
 
-import json
 import os
 import shutil
 import subprocess
@@ -87,44 +86,26 @@ def build(commit):
     return binary
 
 
-def per_ray(binary, commit, workload):
-    """Instructions per ray: cachegrind at the size minus at 1x1, over the
-    render's rays (the README's method)."""
-    _, args, width, height, single = workload
-    env = {**os.environ, "GLINT_SIMD": "avx2"}
-    if single:
-        if commit is None or STEPS_ORDER.index(commit) >= STEPS_ORDER.index(PACKETS_OFF_SINCE):
-            env["GLINT_PACKETS"] = "off"
-        else:
-            env["GLINT_SIMD"] = "scalar"
-
-    def count(w, h):
-        with tempfile.TemporaryDirectory() as d:
-            out = os.path.join(d, "cg.out")
-            run(["valgrind", "--tool=cachegrind", "--cache-sim=no",
-                 f"--cachegrind-out-file={out}", binary, "render", *args,
-                 "-o", os.path.join(d, "x.png"), "--width", str(w), "--height", str(h),
-                 "--threads", "1", "-q"], env=env)
-            with open(out) as f:
-                for line in f:
-                    if line.startswith("summary:"):
-                        return int(line.split()[1])
-        sys.exit("step_history: no cachegrind summary")
-
-    with tempfile.TemporaryDirectory() as d:
-        stats = json.loads(run([binary, "render", *args, "-o", os.path.join(d, "x.png"),
-                                "--width", str(width), "--height", str(height),
-                                "--threads", "1", "--stats", "-q"], env=env))
-    return (count(width, height) - count(1, 1)) / stats["rays"]["total"]
+def extra_env(commit, single):
+    """What `commit`'s binary needs in its environment to trace every ray
+    singly (nothing for the other workloads; `None` is now)."""
+    if not single:
+        return {}
+    if commit is None or STEPS_ORDER.index(commit) >= STEPS_ORDER.index(PACKETS_OFF_SINCE):
+        return {"GLINT_PACKETS": "off"}
+    return {"GLINT_SIMD": "scalar"}
 
 
-def table(now):
+def table(now, instructions):
     """The markdown table: a row per workload, a column per step and now
-    (`now`: the current release binary)."""
+    (`now`: the current release binary). `instructions(args, width,
+    height, env, binary)` counts a workload's instructions per ray, by the
+    README's method (readme_figures.py's)."""
     columns = [(commit, build(commit)) for commit in STEPS_ORDER] + [(None, now)]
-    jobs = [(b, c, w) for w in WORKLOADS for c, b in columns]
+    jobs = [(args, w, h, extra_env(c, single), b)
+            for _, args, w, h, single in WORKLOADS for c, b in columns]
     with ThreadPoolExecutor(2) as pool:
-        counts = list(pool.map(lambda job: per_ray(*job), jobs))
+        counts = list(pool.map(lambda job: instructions(*job), jobs))
     head = " | ".join(f"{name} `{commit}`" for name, commit in STEPS)
     lines = [f"| workload | {head} | now |", "|---|" + "---:|" * (len(columns))]
     for i, (name, *_) in enumerate(WORKLOADS):
