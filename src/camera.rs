@@ -149,10 +149,25 @@ impl Camera {
         -(p - self.eye).dot(self.w)
     }
 
+    /// The image plane at distance 1 along the view: its top-left corner's
+    /// offsets along `u` and `v` and a pixel's size, so that a direction
+    /// `d` ahead of the eye shows at `((d.u / z - left) / size, (top - d.v
+    /// / z) / size)` with `z = -d.w` ([`Camera::project_direction`], for
+    /// callers that project many points with their own arithmetic).
+    pub fn image_plane(&self) -> (f64, f64, f64) {
+        (self.left, self.top, self.pixel_size)
+    }
+
     /// Continuous image coordinates of `p` (pixels, x to the right, y down
     /// from the top-left corner), for points with positive view depth.
     pub fn project(&self, p: DVec3) -> Option<(f64, f64)> {
-        let d = p - self.eye;
+        self.project_direction(p - self.eye)
+    }
+
+    /// Continuous image coordinates of the point at infinity in direction
+    /// `d` (where a ray leaving the scene that way is seen), for directions
+    /// ahead of the eye; also of the point `eye + d`.
+    pub fn project_direction(&self, d: DVec3) -> Option<(f64, f64)> {
         let z = -d.dot(self.w);
         if !(z > 0.0) {
             return None;

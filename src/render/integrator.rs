@@ -134,6 +134,7 @@ impl Renderer<'_> {
             _ => self.materials[material as usize].color,
         };
         rec.material(material);
+        rec.surface(point);
         rec.hit(|| HitRecord {
             object: hit.shape,
             kind: shape.kind(),

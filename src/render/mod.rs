@@ -14,6 +14,7 @@ pub mod memory;
 mod packets;
 mod passes;
 pub mod ray_tree;
+pub mod render_cache;
 mod sampling;
 mod tile_job;
 pub mod tiles;

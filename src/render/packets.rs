@@ -271,7 +271,7 @@ impl Renderer<'_> {
     /// [`Renderer::sample`] for each of `rays` (at most `N`), with their
     /// recorders `recs`.
     #[inline(always)]
-    fn sample_lanes<S: pulp::Simd, C: Counter, R: RayRecorder, const N: usize>(
+    pub(super) fn sample_lanes<S: pulp::Simd, C: Counter, R: RayRecorder, const N: usize>(
         &self,
         simd: S,
         rays: &[Ray],
@@ -303,7 +303,7 @@ impl Renderer<'_> {
     /// Each ray's closest hit: as a packet through the octree where the
     /// rays allow, one by one otherwise.
     #[inline(always)]
-    fn closest_lanes<S: pulp::Simd, C: Counter, const N: usize>(
+    pub(super) fn closest_lanes<S: pulp::Simd, C: Counter, const N: usize>(
         &self,
         simd: S,
         rays: &[Ray],

@@ -148,6 +148,9 @@ pub trait RayRecorder: Sized {
     /// The material of the surface hit (cheap, for the adaptive sampler).
     #[inline(always)]
     fn material(&mut self, _index: u32) {}
+    /// Where the ray hit (cheap, for the render cache).
+    #[inline(always)]
+    fn surface(&mut self, _point: crate::math::DVec3) {}
     /// Whether light `index` reaches the hit point.
     #[inline(always)]
     fn light(&mut self, _index: usize, _lit: bool) {}

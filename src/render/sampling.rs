@@ -143,7 +143,7 @@ impl Renderer<'_> {
     }
 
     /// [`Renderer::sample`], telling `rec` what the ray met.
-    fn sample_recorded<C: Counter, R: RayRecorder>(
+    pub(super) fn sample_recorded<C: Counter, R: RayRecorder>(
         &self,
         ray: &Ray,
         query: &mut Query<C>,
