@@ -9,15 +9,17 @@ use std::sync::Arc;
 use egui::{Color32, Sense, TextureHandle, TextureOptions};
 
 mod octree_tuning;
+mod options;
 mod scene_files;
 
 use octree_tuning::build_octree;
+pub use options::ViewerOptions;
 
 use super::command::Command;
 use super::compare::{Compare, CompareMode, DiffStats};
 use super::inspect::InspectState;
 use super::octree_panel::{OctreeInfo, RaySampleJob, SuggestionJob, last_full_pass};
-use super::orbit_bench::{OrbitBench, OrbitBenchOptions, ShownFrame};
+use super::orbit_bench::{CapturedPreview, OrbitBench, ShownFrame};
 use super::panels::{Message, RenderInfo};
 use super::pixel::Inspection;
 use super::pixel::WalkTarget;
@@ -30,7 +32,7 @@ use crate::accel::{Octree, OctreeParams};
 use crate::camera::CameraSpec;
 use crate::render::UnitCosts;
 use crate::scene::Scene;
-use crate::settings::{AntiAliasing, Overrides, RenderSettings};
+use crate::settings::{AntiAliasing, RenderSettings};
 
 /// Pixels stay sharp blocks when magnified; a large image shrunk to fit
 /// is filtered rather than losing whole rows.
@@ -39,37 +41,6 @@ const TEXTURE: TextureOptions = TextureOptions {
     minification: egui::TextureFilter::Linear,
     ..TextureOptions::NEAREST
 };
-
-/// Start-up options of the viewer.
-#[derive(Clone, Debug, Default)]
-pub struct ViewerOptions {
-    /// Save a screenshot of the whole window here once the final pass is on
-    /// screen, then exit.
-    pub screenshot: Option<PathBuf>,
-    /// Where the screenshot's success or failure is reported.
-    pub screenshot_outcome: super::screenshot::ScreenshotOutcome,
-    /// Frames to wait after the final pass before the screenshot.
-    pub frames: u32,
-    /// Render threads (0 = one per core).
-    pub threads: usize,
-    /// Initial settings that differ from the scene's (size, view, octree,
-    /// anti-aliasing, protocol, colours, sides).
-    pub overrides: Overrides,
-    /// Start with the octree overlay drawn down to this level.
-    pub overlay_depth: Option<u32>,
-    /// Start with this pixel's ray tree inspected.
-    pub inspect: Option<(u32, u32)>,
-    /// And this ray's octree walk shown, to this many steps (`None`: all).
-    pub walk: Option<(WalkTarget, Option<usize>)>,
-    /// Start by comparing against the image with this setting flipped:
-    /// A is rendered with it flipped and pinned, then B as given.
-    pub compare: Option<CompareSetting>,
-    /// Show the comparison as a difference rather than a split.
-    pub compare_difference: bool,
-    /// Orbit the scene with synthetic pointer events once its first image
-    /// is complete, print the benchmark's report on stdout, then exit.
-    pub orbit_bench: Option<OrbitBenchOptions>,
-}
 
 /// Everything that decides the rendered image; a change restarts the passes.
 #[derive(Clone, Debug, PartialEq)]
@@ -80,6 +51,7 @@ struct RenderInputs {
     /// The octree's parameters: a new tree renders again (for its times).
     octree: OctreeParams,
     preview: Option<Preview>,
+    show_sources: bool,
 }
 
 /// What waits for the user to confirm that unsaved edits may go.
@@ -127,6 +99,9 @@ pub struct GlintApp {
     shown_version: u64,
     submitted: Option<RenderInputs>,
     dragging: bool,
+    /// A panel's value (a light, a material, the camera) is being dragged:
+    /// its changes are previewed like the camera's drag.
+    widget_dragged: bool,
     /// What the budget chose for the last drag, and its estimated seconds.
     last_preview: Option<(Preview, f64)>,
     asked_focus: bool,
@@ -165,6 +140,7 @@ impl GlintApp {
             scene_version: 0,
             settings,
             frame_budget_ms: 33.0,
+            show_sources: options.show_sources,
         };
         // Before `--compare` flips a setting for its A image: B, which
         // follows, is the state as loaded.
@@ -191,6 +167,7 @@ impl GlintApp {
             shown_version: 0,
             submitted: None,
             dragging: false,
+            widget_dragged: false,
             last_preview: None,
             asked_focus: false,
             messages: Vec::new(),
@@ -557,7 +534,9 @@ impl GlintApp {
         }
         let (camera, moved) = input::camera_control(ui, &response, &self.edit.camera, size.y);
         self.edit.camera = camera;
-        self.dragging = response.is_pointer_button_down_on() && (moved || self.dragging);
+        let on_image = response.is_pointer_button_down_on();
+        self.dragging = on_image && (moved || self.dragging);
+        self.widget_dragged = ui.ctx().dragged_id().is_some() && !on_image;
         commands
     }
 
@@ -618,6 +597,20 @@ impl GlintApp {
         let history = self.worker.history();
         let preview = if self.dragging {
             budget::choose_preview(&history, &self.edit.settings, self.edit.frame_budget_ms)
+        } else if self.widget_dragged
+            && budget::reuses(&self.edit.settings)
+            && self.submitted.as_ref().is_some_and(|s| {
+                s.settings == self.edit.settings
+                    && s.octree == self.octree.params()
+                    && (s.camera != self.edit.camera || s.scene_version != self.edit.scene_version)
+            })
+        {
+            // A light, a material or the camera dragged in a panel: the
+            // render cache re-traces what the change touches.
+            Some((
+                Preview::Reuse,
+                budget::reuse_seconds(self.edit.frame_budget_ms),
+            ))
         } else {
             None
         };
@@ -628,6 +621,7 @@ impl GlintApp {
             scene_version: edit.scene_version,
             octree: self.octree.params(),
             preview: preview.map(|(p, _)| p),
+            show_sources: edit.show_sources,
         };
         if self.submitted.as_ref() == Some(&inputs) {
             return;
@@ -658,6 +652,8 @@ impl GlintApp {
             camera: edit.camera,
             settings: edit.settings,
             preview: inputs.preview,
+            frame_budget_ms: edit.frame_budget_ms,
+            show_sources: edit.show_sources,
             serial: self.input_serial,
         };
         // While dragging, the preview in flight is finished and shown; this
@@ -678,26 +674,28 @@ impl GlintApp {
     /// Uploads the display buffer to the texture if new tiles arrived.
     fn update_texture(&mut self, ctx: &egui::Context) {
         let shown = self.shown_version;
+        let saving = self
+            .orbit_bench
+            .as_ref()
+            .is_some_and(OrbitBench::saves_previews);
         let update = self.worker.try_with_buffer(|b| {
             (b.version != shown && b.width > 0).then(|| {
+                // The orbit benchmark keeps previews it saves as shown.
+                let capture = saving.then(|| CapturedPreview::of(b)).flatten();
                 (
                     b.version,
                     egui::ColorImage::from_rgba_unmultiplied(
                         [b.width as usize, b.height as usize],
                         &b.rgba,
                     ),
-                    ShownFrame {
-                        generation: b.generation,
-                        serial: b.serial,
-                        pass: b.pass,
-                        finished: b.finished,
-                    },
+                    ShownFrame::of(b),
+                    capture,
                 )
             })
         });
-        if let Some(Some((version, image, frame))) = update {
+        if let Some(Some((version, image, frame, capture))) = update {
             if let Some(bench) = &mut self.orbit_bench {
-                bench.shown(frame);
+                bench.shown(frame, || capture);
             }
             self.shown_version = version;
             match &mut self.texture {

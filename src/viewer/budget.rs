@@ -1,9 +1,22 @@
-//! The frame budget while the user drags: which preview (resolution,
-//! reflections, shadows) fits the time, estimated from the passes so far.
+//! The frame budget while the user drags: the render cache where it
+//! serves the view, else which reduced preview (resolution, reflections,
+//! shadows) fits the time, estimated from the passes so far.
 
-use super::worker::{PassRecord, Preview, Reflections};
+pub use super::preview::reuse_seconds;
+use super::worker::{PassRecord, Preview, Reduced, Reflections};
 use crate::render::PassKind as Engine;
 use crate::settings::RenderSettings;
+
+/// Whether previews while moving use the render cache: where it serves the
+/// view ([`crate::render::render_cache::serves`]), unless the environment
+/// variable `GLINT_PREVIEW` is `reduced` (the reduced previews glint showed
+/// before it, to compare the two on the same build). Read once.
+pub fn reuses(settings: &RenderSettings) -> bool {
+    static REDUCED: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    let reduced =
+        *REDUCED.get_or_init(|| std::env::var("GLINT_PREVIEW").is_ok_and(|v| v == "reduced"));
+    !reduced && crate::render::render_cache::serves(settings)
+}
 
 /// The preview to render while the user drags: the best image whose estimated time fits the frame budget. Candidates in order
 /// of preference: full, 1/2, 1/4, 1/8 resolution, each first complete,
@@ -18,7 +31,19 @@ pub fn choose_preview(
     settings: &RenderSettings,
     budget_ms: f64,
 ) -> Option<(Preview, f64)> {
-    let fallback = Preview {
+    if reuses(settings) {
+        return Some((Preview::Reuse, reuse_seconds(budget_ms)));
+    }
+    choose_reduced(history, settings, budget_ms).map(|(p, t)| (Preview::Reduced(p), t))
+}
+
+/// The reduced preview that fits `budget_ms`, and its estimated seconds.
+fn choose_reduced(
+    history: &[PassRecord],
+    settings: &RenderSettings,
+    budget_ms: f64,
+) -> Option<(Reduced, f64)> {
+    let fallback = Reduced {
         divisor: 4,
         reflections: Reflections::All,
         shadows: true,
@@ -28,7 +53,7 @@ pub fn choose_preview(
     }) else {
         return Some((fallback, f64::NAN));
     };
-    let estimate = |p: &Preview| estimate_preview(base, p, settings);
+    let estimate = |p: &Reduced| estimate_preview(base, p, settings);
     // How far off the model was on the last preview it predicted: slower
     // than estimated makes every estimate more careful. Faster than
     // estimated makes none bolder: the model prices every ray alike, while
@@ -39,7 +64,7 @@ pub fn choose_preview(
     let correction = history
         .iter()
         .rev()
-        .find_map(|r| match r.kind.preview {
+        .find_map(|r| match r.kind.preview.and_then(|p| p.reduced()) {
             Some(p) if r.finished_at > base.finished_at => {
                 Some((r.seconds / estimate(&p)).clamp(1.0, 4.0))
             }
@@ -50,11 +75,13 @@ pub fn choose_preview(
     // recent times (the median of its last three), the model only guides
     // the choice of candidates not yet tried: a fixed cost per preview
     // makes the model's pixel scaling too hopeful for large previews.
-    let measured = |p: &Preview| {
+    let measured = |p: &Reduced| {
         let mut times: Vec<f64> = history
             .iter()
             .rev()
-            .filter(|r| r.kind.preview == Some(*p) && r.finished_at > base.finished_at)
+            .filter(|r| {
+                r.kind.preview == Some(Preview::Reduced(*p)) && r.finished_at > base.finished_at
+            })
             .take(3)
             .map(|r| r.seconds)
             .collect();
@@ -69,7 +96,7 @@ pub fn choose_preview(
             (Reflections::Off, true),
             (Reflections::Off, false),
         ]
-        .map(|(reflections, shadows)| Preview {
+        .map(|(reflections, shadows)| Reduced {
             divisor,
             reflections,
             shadows,
@@ -92,7 +119,7 @@ pub fn choose_preview(
 /// or a secondary ray's) spawns on average the same number of secondary
 /// and of shadow rays, so one bounce keeps the secondary rays of eye-ray
 /// hits, and dropping reflections keeps only the eye-ray hits' shadow rays.
-fn estimate_preview(base: &PassRecord, preview: &Preview, settings: &RenderSettings) -> f64 {
+fn estimate_preview(base: &PassRecord, preview: &Reduced, settings: &RenderSettings) -> f64 {
     let per_pixel = base.seconds / (base.width as f64 * base.height as f64).max(1.0);
     let d = preview.divisor as f64;
     let pixels = (settings.width as f64 / d).max(1.0) * (settings.height as f64 / d).max(1.0);
@@ -153,6 +180,7 @@ mod tests {
             max_depth: 5,
             protocol: crate::settings::Protocol::Glint,
             from_cache: false,
+            reuse: None,
         }
     }
 
@@ -175,13 +203,13 @@ mod tests {
 
     #[test]
     fn the_budget_picks_the_best_preview_that_fits() {
-        let p = |divisor, reflections, shadows| Preview {
+        let p = |divisor, reflections, shadows| Reduced {
             divisor,
             reflections,
             shadows,
         };
         let history = [base()];
-        let choose = |ms| choose_preview(&history, &settings(), ms).map(|(p, _)| p);
+        let choose = |ms| choose_reduced(&history, &settings(), ms).map(|(p, _)| p);
         // The full 1-sample pass took 400 ms.
         assert_eq!(choose(500.0), Some(p(1, Reflections::All, true)));
         // 1/2 resolution: 100 ms; without reflections 100 * 260/380 = 68 ms.
@@ -198,7 +226,7 @@ mod tests {
         assert_eq!(choose(0.001), Some(p(8, Reflections::Off, false)));
         // No full pass yet: a quarter-resolution guess.
         assert_eq!(
-            choose_preview(&[], &settings(), 33.0).map(|(p, _)| p),
+            choose_reduced(&[], &settings(), 33.0).map(|(p, _)| p),
             Some(p(4, Reflections::All, true))
         );
     }
@@ -209,18 +237,18 @@ mod tests {
         // model is scaled by 4, so 1/2 bare (4 x 26 ms) no longer fits 33 ms
         // and 1/4 bare (4 x 6.6 ms) does.
         let mut slow = base();
-        slow.kind = ShownPass::drag_preview(Preview {
+        slow.kind = ShownPass::drag_preview(Preview::Reduced(Reduced {
             divisor: 4,
             reflections: Reflections::All,
             shadows: true,
-        });
+        }));
         slow.seconds = 0.1;
         slow.finished_at = 2.0;
         let history = [base(), slow];
-        let (chosen, estimate) = choose_preview(&history, &settings(), 33.0).unwrap();
+        let (chosen, estimate) = choose_reduced(&history, &settings(), 33.0).unwrap();
         assert_eq!(
             chosen,
-            Preview {
+            Reduced {
                 divisor: 4,
                 reflections: Reflections::Off,
                 shadows: false
@@ -237,13 +265,13 @@ mod tests {
         // The full 1-sample pass took 400 ms, so the model puts 1/2 at
         // 100 ms, within 104 ms; measured at 150 ms it is left out, and
         // 1/2 with one bounce (89 ms) is next.
-        let p = |divisor, reflections| Preview {
+        let p = |divisor, reflections| Reduced {
             divisor,
             reflections,
             shadows: true,
         };
         let at = |kind, seconds, finished_at| PassRecord {
-            kind: ShownPass::drag_preview(kind),
+            kind: ShownPass::drag_preview(Preview::Reduced(kind)),
             seconds,
             finished_at,
             ..base()
@@ -254,15 +282,15 @@ mod tests {
             at(p(2, Reflections::All), 0.15, 2.0),
             at(p(4, Reflections::All), 0.025, 3.0),
         ];
-        let (chosen, estimate) = choose_preview(&history, &settings(), 104.0).unwrap();
+        let (chosen, estimate) = choose_reduced(&history, &settings(), 104.0).unwrap();
         assert_eq!(chosen, p(2, Reflections::OneBounce));
         assert!((estimate - 0.1 * 340.0 / 380.0).abs() < 1e-12, "{estimate}");
         let unmeasured = [base(), history[2]];
-        let (chosen, _) = choose_preview(&unmeasured, &settings(), 104.0).unwrap();
+        let (chosen, _) = choose_reduced(&unmeasured, &settings(), 104.0).unwrap();
         assert_eq!(chosen, p(2, Reflections::All));
         // A preview faster than estimated makes no other estimate bolder.
         let fast = [base(), at(p(4, Reflections::All), 0.005, 3.0)];
-        let (chosen, estimate) = choose_preview(&fast, &settings(), 104.0).unwrap();
+        let (chosen, estimate) = choose_reduced(&fast, &settings(), 104.0).unwrap();
         assert_eq!(chosen, p(2, Reflections::All));
         assert!((estimate - 0.1).abs() < 1e-12, "{estimate}");
     }
@@ -270,7 +298,7 @@ mod tests {
     #[test]
     fn preview_estimates_scale_with_pixels_and_rays_cast() {
         let settings = settings();
-        let p = |divisor, reflections, shadows| Preview {
+        let p = |divisor, reflections, shadows| Reduced {
             divisor,
             reflections,
             shadows,

@@ -336,12 +336,15 @@ mod tests {
             max_depth: 5,
             protocol: crate::settings::Protocol::Glint,
             from_cache: false,
+            reuse: None,
         };
-        let preview = ShownPass::drag_preview(super::super::worker::Preview {
-            divisor: 2,
-            reflections: super::super::worker::Reflections::All,
-            shadows: true,
-        });
+        let preview = ShownPass::drag_preview(super::super::worker::Preview::Reduced(
+            super::super::worker::Reduced {
+                divisor: 2,
+                reflections: super::super::worker::Reflections::All,
+                shadows: true,
+            },
+        ));
         let history = [
             pass(1, ShownPass::full(Engine::OneSample), 0.5),
             pass(2, preview, 0.01),

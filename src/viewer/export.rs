@@ -65,23 +65,7 @@ pub fn export_to(
     let Some(shown) = shown.filter(|_| w > 0 && h > 0) else {
         anyhow::bail!("nothing has been rendered yet");
     };
-    // The rendered scene's own name and text, which belong together (a
-    // save since may have renamed the file in the window), by its absolute
-    // path so that `--from-png` finds it and its meshes from any folder.
-    let scene_name = if shown.scene.name == crate::scene::builtin::NAME {
-        shown.scene.name.clone()
-    } else {
-        let p = Path::new(&shown.scene.name);
-        std::fs::canonicalize(p)
-            .or_else(|_| std::path::absolute(p))
-            .map_or_else(|_| shown.scene.name.clone(), |p| p.display().to_string())
-    };
-    let mut record = RenderRecord::new(&shown.scene, &scene_name, &shown.camera, shown.settings);
-    // Lights and materials as rendered (the panels may have edited them).
-    record.settings.edits = Some(SceneEdits {
-        lights: shown.scene.lights.clone(),
-        materials: shown.scene.materials.clone(),
-    });
+    let mut record = record_of(&shown, shown.settings);
     match frame {
         Some(f) if finished && f.width == w && f.height == h => {
             let camera = crate::camera::Camera::new(&shown.camera, w, h)?;
@@ -99,6 +83,31 @@ pub fn export_to(
         }
     }
     Ok(())
+}
+
+/// The record of an image of `shown` rendered with `settings`: the
+/// rendered scene's own name and text, which belong together (a save since
+/// may have renamed the file in the window), by its absolute path so that
+/// `--from-png` finds it and its meshes from any folder, and the lights
+/// and materials as rendered (the panels may have edited them).
+pub(super) fn record_of(
+    shown: &super::worker::FrameSource,
+    settings: crate::settings::RenderSettings,
+) -> RenderRecord {
+    let scene_name = if shown.scene.name == crate::scene::builtin::NAME {
+        shown.scene.name.clone()
+    } else {
+        let p = Path::new(&shown.scene.name);
+        std::fs::canonicalize(p)
+            .or_else(|_| std::path::absolute(p))
+            .map_or_else(|_| shown.scene.name.clone(), |p| p.display().to_string())
+    };
+    let mut record = RenderRecord::new(&shown.scene, &scene_name, &shown.camera, settings);
+    record.settings.edits = Some(SceneEdits {
+        lights: shown.scene.lights.clone(),
+        materials: shown.scene.materials.clone(),
+    });
+    record
 }
 
 /// rfd's dialogs go through the XDG desktop portal on D-Bus; without a

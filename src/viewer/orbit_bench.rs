@@ -11,19 +11,46 @@
 //! up axis at a constant rate, its height unchanged: the last view shows
 //! the scene from another side, as costly to render as the first.
 
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use egui::{Event, Modifiers, PointerButton, Pos2};
 
-use super::worker::{PassRecord, PreviewCounts, ShownPass};
+use super::worker::{DisplayBuffer, FrameSource, PassRecord, PreviewCounts, ShownPass};
 
 /// What the benchmark drives.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct OrbitBenchOptions {
     /// How long the drag lasts.
     pub seconds: f64,
     /// Pointer events per second.
     pub event_hz: f64,
+    /// Write each preview shown during the drag here, as shown, once the
+    /// benchmark is over (so writing costs the drag nothing).
+    pub save_previews: Option<PathBuf>,
+}
+
+/// A preview as it was shown, kept until the benchmark is over.
+pub struct CapturedPreview {
+    pub rgba: Vec<u8>,
+    pub width: u32,
+    pub height: u32,
+    pub source: FrameSource,
+}
+
+impl CapturedPreview {
+    /// The picture in `b` as shown, if it is a finished preview.
+    pub fn of(b: &DisplayBuffer) -> Option<Self> {
+        if !(b.finished && b.pass.is_some_and(|p| p.preview.is_some())) {
+            return None;
+        }
+        b.source.clone().map(|source| Self {
+            rgba: b.rgba.clone(),
+            width: b.width,
+            height: b.height,
+            source,
+        })
+    }
 }
 
 /// A shown frame, as the UI uploaded it.
@@ -34,6 +61,18 @@ pub struct ShownFrame {
     pub serial: u64,
     pub pass: Option<ShownPass>,
     pub finished: bool,
+}
+
+impl ShownFrame {
+    /// The frame `b` holds.
+    pub fn of(b: &DisplayBuffer) -> Self {
+        Self {
+            generation: b.generation,
+            serial: b.serial,
+            pass: b.pass,
+            finished: b.finished,
+        }
+    }
 }
 
 enum Phase {
@@ -71,6 +110,8 @@ struct Drag {
 pub struct OrbitBench {
     options: OrbitBenchOptions,
     phase: Phase,
+    /// The previews shown, when they are to be saved.
+    captured: Vec<CapturedPreview>,
     /// When the next frame is needed (asked for during the frame: a
     /// request made before it begins is spent on the frame itself).
     wake: Option<Instant>,
@@ -88,8 +129,14 @@ impl OrbitBench {
         Self {
             options,
             phase: Phase::Waiting,
+            captured: Vec::new(),
             wake: None,
         }
+    }
+
+    /// Whether shown previews are kept to be saved.
+    pub fn saves_previews(&self) -> bool {
+        self.options.save_previews.is_some()
     }
 
     /// Moves in the drag: one per event period, the press with the first.
@@ -190,8 +237,9 @@ impl OrbitBench {
     }
 
     /// Called when the UI uploads a new image: counts shown previews and
-    /// answers the moves it reflects.
-    pub fn shown(&mut self, frame: ShownFrame) {
+    /// answers the moves it reflects. `capture` gives the image as shown,
+    /// asked for only when it is a new preview and previews are saved.
+    pub fn shown(&mut self, frame: ShownFrame, capture: impl FnOnce() -> Option<CapturedPreview>) {
         let (Phase::Dragging(drag) | Phase::Settling(drag)) = &mut self.phase else {
             return;
         };
@@ -209,6 +257,11 @@ impl OrbitBench {
         {
             drag.previews_shown += 1;
             drag.last_preview_generation = frame.generation;
+            if self.options.save_previews.is_some()
+                && let Some(c) = capture()
+            {
+                self.captured.push(c);
+            }
         }
         while let Some(&(at, serial)) = drag.moves.get(drag.answered) {
             if serial > frame.serial {
@@ -238,8 +291,21 @@ impl OrbitBench {
             return None;
         }
         let final_ms = released_at.elapsed().as_secs_f64() * 1000.0;
-        let report = report(drag, &self.options, final_ms, history, counts, describe);
+        let mut report = report(drag, &self.options, final_ms, history, counts, describe);
         self.phase = Phase::Done;
+        if let (Some(dir), Some(out)) = (&self.options.save_previews, report.as_object_mut()) {
+            let captured = std::mem::take(&mut self.captured);
+            match save_previews(dir, &captured) {
+                Ok(n) => {
+                    out.insert("previews_saved".into(), n.into());
+                    out.insert("previews_dir".into(), dir.display().to_string().into());
+                }
+                Err(e) => {
+                    out.insert("previews_saved".into(), 0.into());
+                    out.insert("previews_save_error".into(), format!("{e:#}").into());
+                }
+            }
+        }
         Some(report)
     }
 
@@ -253,6 +319,29 @@ impl OrbitBench {
     pub fn is_done(&self) -> bool {
         matches!(self.phase, Phase::Done)
     }
+}
+
+/// Writes each captured preview to `dir/preview_NNNN.png` (from 0001, in
+/// the order shown) at the size of the frame it stands for, as the viewer
+/// drew it (a reduced preview scaled up to its nearest pixels), with the
+/// record of that frame: `glint render --from-png` on it renders the final
+/// image at the preview's camera. Returns how many were written.
+fn save_previews(dir: &std::path::Path, captured: &[CapturedPreview]) -> anyhow::Result<usize> {
+    use crate::image::frame::{resample_rgba, rgba_to_rgb};
+    std::fs::create_dir_all(dir)?;
+    for (k, c) in captured.iter().enumerate() {
+        let settings = c.source.frame_settings;
+        let (w, h) = (settings.width, settings.height);
+        let rgba = if (c.width, c.height) == (w, h) {
+            std::borrow::Cow::Borrowed(&c.rgba)
+        } else {
+            std::borrow::Cow::Owned(resample_rgba(&c.rgba, c.width, c.height, w, h))
+        };
+        let record = super::export::record_of(&c.source, settings);
+        let path = dir.join(format!("preview_{:04}.png", k + 1));
+        crate::export::save_rgb_png(&path, w, h, &rgba_to_rgb(&rgba), Some(&record))?;
+    }
+    Ok(captured.len())
 }
 
 /// The events that count towards the viewer's input serial.

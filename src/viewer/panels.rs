@@ -259,18 +259,34 @@ fn render_settings_ui(edit: &mut EditState, ui: &mut egui::Ui) {
             }
         });
     ui.horizontal(|ui| {
-            ui.label("Frame budget while moving");
-            ui.add(
-                DragValue::new(&mut edit.frame_budget_ms).update_while_editing(false)
-                    .range(5.0..=1000.0)
-                    .speed(1.0)
-                    .suffix(" ms"),
-            )
-            .on_hover_text(
-                "while you drag, glint renders the best preview it estimates fits this time: \
-                 full resolution, then 1/2, 1/4, 1/8, each complete, then with one bounce of reflection, then without reflections, then without shadows too",
-            );
-        });
+        ui.label("Frame budget while moving");
+        ui.add(
+            DragValue::new(&mut edit.frame_budget_ms)
+                .update_while_editing(false)
+                .range(5.0..=1000.0)
+                .speed(1.0)
+                .suffix(" ms"),
+        )
+        .on_hover_text(
+            "while you drag, each preview fits this time: the shaded view moves the last \
+                 picture's points into the new view and spends what that leaves of three \
+                 quarters of it on fresh rays where the picture needs them most (the render \
+                 cache, a point for every pixel or every 2x2 to 4x4 pixels as the time allows); \
+                 the other views render the best \
+                 reduced preview estimated to fit: full resolution, then 1/2, 1/4, 1/8, each \
+                 complete, then with one bounce of reflection, then without reflections, then \
+                 without shadows too",
+        );
+    });
+    ui.checkbox(
+        &mut edit.show_sources,
+        "While moving, show where pixels come from",
+    )
+    .on_hover_text(
+        "colour each pixel of the moving picture by its source: a fresh ray (green), a \
+             point reused from earlier frames (blue when new, violet when old), a point an edit \
+             changed and not yet traced again (orange), or filled from its neighbours (red)",
+    );
     image_size_ui(edit, ui);
     ui.horizontal_wrapped(|ui| {
         ui.label("View");
@@ -384,31 +400,48 @@ pub fn status_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) -> Vec<
                 b.pass_started.map(|t| t.elapsed().as_secs_f64()),
                 b.stopped,
                 b.generation == newest,
+                b.generation,
             )
         });
         match status {
             // The buffer describes the image before until the new job's
             // first pass starts: that image is neither "done" nor the
             // progress of the new one.
-            Some((Some(pass), .., false, false)) if pass.preview.is_none() => {
+            Some((Some(pass), .., false, false, _)) if pass.preview.is_none() => {
                 ui.label("starting the new image…");
             }
-            Some((Some(pass), done, total, _, _, true, _)) => {
+            Some((Some(pass), done, total, _, _, true, _, _)) => {
                 let pct = 100.0 * done as f64 / total.max(1) as f64;
                 ui.label(format!(
                     "stopped: {} at {pct:.0}% (any change renders again)",
                     pass.label()
                 ));
             }
-            Some((Some(pass), done, total, finished, elapsed, false, _)) => {
+            Some((Some(pass), done, total, finished, elapsed, false, _, generation)) => {
                 if let Some(p) = pass.preview {
-                    // A drag's frames: the full passes follow on release.
-                    ui.label(format!(
-                        "moving: preview {} ({}x{}); the full image follows when you let go",
-                        p.describe(),
-                        (edit.settings.width / p.divisor).max(1),
-                        (edit.settings.height / p.divisor).max(1)
-                    ));
+                    // The frames while moving: the full passes follow on release.
+                    ui.label(match p {
+                        Preview::Reuse => {
+                            let made_of = info
+                                .worker
+                                .history()
+                                .iter()
+                                .rev()
+                                .find(|r| r.generation == generation)
+                                .and_then(|r| r.reuse)
+                                .map_or_else(String::new, |s| format!(": {}", s.describe()));
+                            format!(
+                                "moving: full picture from the render cache{made_of}; \
+                                 the exact image follows when you let go"
+                            )
+                        }
+                        Preview::Reduced(r) => format!(
+                            "moving: preview {} ({}x{}); the full image follows when you let go",
+                            r.describe(),
+                            (edit.settings.width / r.divisor).max(1),
+                            (edit.settings.height / r.divisor).max(1)
+                        ),
+                    });
                 } else if finished {
                     ui.label(format!(
                         "done: {} ({}x{})",

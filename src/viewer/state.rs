@@ -128,6 +128,9 @@ pub struct EditState {
     pub settings: RenderSettings,
     /// Target time of a preview pass while the user drags (milliseconds).
     pub frame_budget_ms: f64,
+    /// While moving, colour the render cache's previews by where each
+    /// pixel came from (fresh ray, reused point by age, filled).
+    pub show_sources: bool,
 }
 
 /// Everything the user can edit, as one value: what undo and redo step

@@ -19,18 +19,23 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use super::pass_cache::{self, PassCache};
-pub use super::preview::{Preview, Reflections};
+pub use super::preview::{Preview, Reduced, Reflections};
 
 mod display;
 mod job;
+mod light_buffers;
 mod pass_record;
+mod reuse;
 
 use crate::image::frame::{Frame, rgb_to_rgba};
 use crate::render::{PassOptions, Renderer};
+use crate::scene::Scene;
 use display::Display;
 pub use display::{DisplayBuffer, FrameSource};
 pub use job::Job;
+use light_buffers::LightBufferCache;
 pub use pass_record::{PassRecord, ShownPass};
+use reuse::ReuseState;
 
 /// The worker's record of finished passes. Previews come at up to 60 a
 /// second while the user drags, so only the newest [`Self::MAX_PREVIEWS`]
@@ -380,6 +385,7 @@ fn run(shared: Arc<Shared>, rx: Receiver<(u64, Job)>, threads: usize) {
         }
     };
     let mut light_buffers = LightBufferCache::default();
+    let mut reuse = ReuseState::default();
     while let Ok(mut next) = rx.recv() {
         // Only the newest job matters.
         let dropped = |job: &Job| {
@@ -398,7 +404,13 @@ fn run(shared: Arc<Shared>, rx: Receiver<(u64, Job)>, threads: usize) {
                 break;
             }
             let started = shared.previews_started.load(Ordering::SeqCst);
-            pool.install(|| render_job(&shared, generation, &job, &mut light_buffers));
+            pool.install(|| {
+                if job.preview == Some(Preview::Reuse) {
+                    reuse_preview(&shared, generation, &job, &mut reuse, &mut light_buffers);
+                } else {
+                    render_job(&shared, generation, &job, &mut light_buffers);
+                }
+            });
             if job.preview.is_some() && shared.previews_started.load(Ordering::SeqCst) == started {
                 // Cancelled before it began (or shown from the cache).
                 dropped(&job);
@@ -428,41 +440,181 @@ fn run(shared: Arc<Shared>, rx: Receiver<(u64, Job)>, threads: usize) {
     }
 }
 
-/// The light buffer of the newest scene's shapes and lights, kept from
-/// job to job: a new camera reuses it; moving a light or loading another
-/// scene builds it again, before that job's first tile.
-#[derive(Default)]
-struct LightBufferCache {
-    /// The geometry it was built over (a scene's clone shares it).
-    shapes: Option<Arc<Vec<crate::shapes::Shape>>>,
-    buffer: Option<crate::accel::LightBuffer>,
-    /// Its build's seconds.
-    seconds: f64,
-}
-
-impl LightBufferCache {
-    /// The buffer of `scene`'s shapes and lights, built now if the kept
-    /// one is of others, and its build's seconds.
-    fn get(&mut self, scene: &crate::scene::Scene) -> Option<(&crate::accel::LightBuffer, f64)> {
-        let lights: Vec<_> = scene.lights.iter().map(|l| l.position).collect();
-        let same_shapes = self
-            .shapes
-            .as_ref()
-            .is_some_and(|s| Arc::ptr_eq(s, &scene.shapes));
-        let fits = |b: &crate::accel::LightBuffer| b.fits(scene.shapes.len(), &lights);
-        if !same_shapes || !self.buffer.as_ref().is_some_and(fits) {
-            let start = Instant::now();
-            self.buffer = scene.build_light_buffer();
-            self.seconds = start.elapsed().as_secs_f64();
-            self.shapes = Some(Arc::clone(&scene.shapes));
-        }
-        self.buffer.as_ref().map(|b| (b, self.seconds))
+/// A render-cache preview of `job`: the cache's points moved into the
+/// job's view, fresh rays for what its time allows
+/// ([`super::preview::reuse_seconds`] of the frame budget), shown
+/// complete (enlarged to the image's size when the cache keeps a point for
+/// a block of pixels). The cache is seeded first from the display's last
+/// finished full pass when that is newer than its points, or from the
+/// picture on screen when its scale changes.
+fn reuse_preview(
+    shared: &Shared,
+    generation: u64,
+    job: &Job,
+    state: &mut ReuseState,
+    light_buffers: &mut LightBufferCache,
+) {
+    use crate::render::render_cache::{PreviewBudget, enlarge, shrink};
+    let start = Instant::now();
+    let scale = state.scale;
+    let full = (job.settings.width, job.settings.height);
+    let mut settings = job.settings;
+    settings.set_anti_aliasing(crate::settings::AntiAliasing::Off);
+    settings.width = full.0.div_ceil(scale);
+    settings.height = full.1.div_ceil(scale);
+    // A buffer is built for a new scene, but not again while a light is
+    // dragged: its build would take a preview's time every frame.
+    let light_buffer = if Renderer::wants_light_buffer(&job.scene, &settings, &job.octree) {
+        light_buffers.kept(&job.scene)
+    } else {
+        None
+    };
+    fn renderer_at<'a>(
+        scene: &'a Scene,
+        job: &'a Job,
+        settings: crate::settings::RenderSettings,
+        camera: &crate::camera::CameraSpec,
+        light_buffer: Option<&'a crate::accel::LightBuffer>,
+    ) -> Result<Renderer<'a>, crate::render::RenderError> {
+        Renderer::with_camera(scene, &job.octree, settings, camera).map(|r| {
+            match &job.bvh {
+                Some(bvh) => r.with_bvh(bvh),
+                None => r,
+            }
+            .with_light_buffer(light_buffer)
+        })
     }
+    let renderer = match renderer_at(&job.scene, job, settings, &job.camera, light_buffer) {
+        Ok(r) => r,
+        Err(e) => {
+            shared.fail(format!("cannot render: {e}"));
+            return;
+        }
+    };
+    shared.previews_started.fetch_add(1, Ordering::SeqCst);
+    // The seed: the last finished full pass on screen if newer than the
+    // points, or the picture on screen if the cache cannot serve this
+    // scale; shrunk to the cache's size.
+    let seed = {
+        let b = shared.buffer.lock().unwrap_or_else(|e| e.into_inner());
+        let newer_final =
+            b.pass.is_some_and(|p| p.preview.is_none()) && b.generation > state.generation;
+        let rescaled = !state.cache.can_serve(&renderer);
+        match (&b.last_frame, &b.source) {
+            (Some(frame), Some(source))
+                if newer_final
+                    && frame.view == crate::settings::ViewMode::Shaded
+                    && (frame.width, frame.height) == full =>
+            {
+                Some((
+                    shrink(&rgb_to_rgba(&frame.to_rgb8()), full, scale),
+                    source.clone(),
+                ))
+            }
+            (_, Some(source))
+                if rescaled
+                    && (b.width, b.height) == full
+                    && b.rgba.len() == 4 * (full.0 * full.1) as usize =>
+            {
+                Some((shrink(&b.rgba, full, scale), source.clone()))
+            }
+            _ => None,
+        }
+    };
+    let seed_renderer = seed.as_ref().and_then(|(_, source)| {
+        renderer_at(&source.scene, job, settings, &source.camera, light_buffer).ok()
+    });
+    if seed_renderer.is_some() {
+        state.cache.clear();
+    }
+    // The rays get what the rest of the preview leaves of its time, and
+    // never less than a third of it: without fresh rays the points thin
+    // out frame by frame.
+    let target = super::preview::reuse_seconds(job.frame_budget_ms);
+    let budget = PreviewBudget {
+        rays: Duration::from_secs_f64((target - state.overhead).max(target / 3.0)),
+    };
+    let seed_pair = seed_renderer
+        .as_ref()
+        .zip(seed.as_ref())
+        .map(|(r, (rgba, _))| (r, rgba.as_slice()));
+    let mut summary = state.cache.preview(&renderer, seed_pair, budget);
+    summary.scale = scale;
+    state.generation = generation;
+    let (image, width, height) = state.cache.image();
+    if job.show_sources {
+        let mut sources = Vec::new();
+        state.cache.source_colors(&mut sources);
+        enlarge(&sources, (width, height), full, false, &mut state.shown);
+    } else {
+        enlarge(image, (width, height), full, true, &mut state.shown);
+    }
+    {
+        let mut b = shared.buffer.lock().unwrap_or_else(|e| e.into_inner());
+        // Swapped with the buffer's own allocation: a new one of a frame's
+        // size costs a millisecond or more of page faults.
+        std::mem::swap(&mut b.rgba, &mut state.shown);
+        b.generation = generation;
+        b.pass = Some(ShownPass::drag_preview(Preview::Reuse));
+        b.stopped = false;
+        b.width = full.0;
+        b.height = full.1;
+        b.serial = job.serial;
+        shared.previews_completed.fetch_add(1, Ordering::SeqCst);
+        b.source = Some(FrameSource {
+            scene: Arc::clone(&job.scene),
+            camera: job.camera,
+            settings,
+            frame_settings: job.settings,
+        });
+        b.finished = true;
+        b.tiles_done = 0;
+        b.tiles_total = 0;
+        b.pass_started = None;
+        // No linear frame: a preview is an approximation, exported only
+        // as shown (and recorded as partial).
+        b.last_frame = None;
+        b.version += 1;
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    // What the preview spent besides rays, smoothed over a few frames.
+    let overhead = (seconds - summary.trace_seconds - summary.seed_seconds).max(0.0);
+    state.overhead = if state.overhead == 0.0 {
+        overhead
+    } else {
+        0.7 * state.overhead + 0.3 * overhead
+    };
+    let next = state.adapt(seconds - summary.seed_seconds, target, &summary);
+    if next != state.scale {
+        state.scale = next;
+        state.overhead = 0.0;
+    }
+    if let Ok(mut history) = shared.history.lock() {
+        history.push(PassRecord {
+            generation,
+            kind: ShownPass::drag_preview(Preview::Reuse),
+            seconds,
+            rays: summary.rays,
+            accel: settings.accel(),
+            anti_aliasing: false,
+            width: full.0,
+            height: full.1,
+            finished_at: shared.started.elapsed().as_secs_f64(),
+            one_sample_error: None,
+            refined_pixels: None,
+            view: settings.view,
+            max_depth: settings.max_depth,
+            protocol: settings.protocol,
+            from_cache: false,
+            reuse: Some(summary),
+        });
+    }
+    (shared.repaint)();
 }
 
 fn render_job(shared: &Shared, generation: u64, job: &Job, light_buffers: &mut LightBufferCache) {
     let mut settings = job.settings;
-    if let Some(p) = job.preview {
+    if let Some(p) = job.preview.and_then(|p| p.reduced()) {
         settings.set_anti_aliasing(crate::settings::AntiAliasing::Off);
         settings.width = (settings.width / p.divisor).max(1);
         settings.height = (settings.height / p.divisor).max(1);
@@ -598,6 +750,7 @@ fn show_cached(
             scene: Arc::clone(&job.scene),
             camera: job.camera,
             settings,
+            frame_settings: job.settings,
         });
         b.serial = job.serial;
         b.last_frame = Some(frame);

@@ -475,12 +475,12 @@ fn protocol_spd_in_the_viewer_is_one_corner_pass() {
 fn a_budget_preview_drops_what_it_says() {
     let worker = Worker::spawn(2, || {});
     let (mut job, _, _) = job("scenes/glass.toml", 96, 72, AntiAliasing::Full);
-    let preview = glint::viewer::worker::Preview {
+    let preview = glint::viewer::worker::Reduced {
         divisor: 2,
         reflections: glint::viewer::worker::Reflections::Off,
         shadows: false,
     };
-    job.preview = Some(preview);
+    job.preview = Some(glint::viewer::worker::Preview::Reduced(preview));
     let generation = worker.submit(job);
     assert!(worker.wait_finished(generation, WAIT));
     let passes: Vec<_> = worker
@@ -491,7 +491,10 @@ fn a_budget_preview_drops_what_it_says() {
         .collect();
     assert_eq!(passes.len(), 1, "one quick pass only");
     let r = passes[0];
-    assert_eq!(r.kind, ShownPass::drag_preview(preview));
+    assert_eq!(
+        r.kind,
+        ShownPass::drag_preview(glint::viewer::worker::Preview::Reduced(preview))
+    );
     assert_eq!((r.width, r.height), (48, 36));
     assert_eq!(r.rays.primary, 48 * 36);
     assert_eq!(
@@ -501,11 +504,11 @@ fn a_budget_preview_drops_what_it_says() {
 
     // One bounce: the picture of a 1-sample render at depth 2 (glass keeps
     // its refraction, a black sphere it is not).
-    let one = glint::viewer::worker::Preview {
+    let one = glint::viewer::worker::Preview::Reduced(glint::viewer::worker::Reduced {
         reflections: glint::viewer::worker::Reflections::OneBounce,
         shadows: true,
         ..preview
-    };
+    });
     let (mut deep, scene, octree) =
         common::viewer::job("scenes/glass.toml", 96, 72, AntiAliasing::Full);
     deep.preview = Some(one);

@@ -81,18 +81,89 @@ fn each_plan_shows_its_passes_and_ends_on_the_cli_frame() {
     }
 }
 
+/// A render-cache preview while moving fills the whole image, is seeded
+/// from the finished image on screen, is close to the exact picture at its
+/// camera (reflections and refraction included), and says what it is made
+/// of; the full passes after it still end on `glint render`'s bytes.
+#[test]
+fn render_cache_previews_fill_the_image_and_the_passes_still_end_on_the_cli_frame() {
+    use glint::viewer::worker::Preview;
+    let worker = Worker::spawn(2, || {});
+    let (still, scene, octree) = job("scenes/glass.toml", 240, 180, AntiAliasing::Off);
+    let g = worker.submit(still.clone());
+    assert!(worker.wait_finished(g, WAIT));
+    let mut moving = still.clone();
+    moving.preview = Some(Preview::Reuse);
+    moving.camera.eye.x += 0.05 * (moving.camera.eye - moving.camera.lookat).length();
+    moving.serial = 1;
+    worker.submit_preview(moving.clone());
+    let start = std::time::Instant::now();
+    while worker.with_buffer(|b| b.serial) != 1 || worker.preview_counts().completed < 1 {
+        assert!(start.elapsed() < WAIT, "{:?}", worker.preview_counts());
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    let (shown, pass) = worker.with_buffer(|b| {
+        assert_eq!((b.width, b.height, b.rgba.len()), (240, 180, 4 * 240 * 180));
+        (rgba_to_rgb(&b.rgba), b.pass)
+    });
+    assert_eq!(pass.and_then(|p| p.preview), Some(Preview::Reuse));
+    let history = worker.history();
+    let summary = history
+        .iter()
+        .rev()
+        .find_map(|r| r.reuse)
+        .expect("the preview's record says what it is made of");
+    assert!(summary.seeded, "{summary:?}");
+    assert!(summary.scale >= 1 && summary.pixels() > 0, "{summary:?}");
+    let mut settings = moving.settings;
+    settings.set_anti_aliasing(AntiAliasing::Off);
+    let exact = |camera: &glint::camera::CameraSpec| {
+        Renderer::with_camera(&scene, &octree, settings, camera)
+            .unwrap()
+            .render(false, None)
+            .0
+            .to_rgb8()
+    };
+    let truth = exact(&moving.camera);
+    let db = psnr(&shown, &truth);
+    // Closer to the picture at the new camera than the picture at the old
+    // one is: the points moved with the view.
+    let old = psnr(&exact(&still.camera), &truth);
+    assert!(
+        db > old + 2.0,
+        "preview {db:.1} dB, old picture {old:.1} dB"
+    );
+    // Released: the full passes at the moved camera, exact as ever.
+    let mut released = moving.clone();
+    released.preview = None;
+    released.serial = 2;
+    let g = worker.submit(released);
+    assert!(worker.wait_finished(g, WAIT));
+    assert!(worker.with_buffer(|b| rgba_to_rgb(&b.rgba)) == truth);
+}
+
+fn psnr(a: &[u8], b: &[u8]) -> f64 {
+    let mse = a
+        .iter()
+        .zip(b)
+        .map(|(&x, &y)| (f64::from(x) - f64::from(y)).powi(2))
+        .sum::<f64>()
+        / a.len() as f64;
+    10.0 * (255.0f64.powi(2) / mse.max(1e-12)).log10()
+}
+
 /// While the user drags, previews asked for while one is in flight do not
 /// cancel it: it completes and is shown, the newest one waits (replacing
 /// the older waiting one) and runs next; a full job cancels both.
 #[test]
 fn previews_in_flight_complete_and_the_newest_waiting_one_follows() {
-    use glint::viewer::worker::{Preview, Reflections};
+    use glint::viewer::worker::{Preview, Reduced, Reflections};
     let worker = Worker::spawn(2, || {});
-    let preview = Preview {
+    let preview = Preview::Reduced(Reduced {
         divisor: 1,
         reflections: Reflections::All,
         shadows: true,
-    };
+    });
     // A preview that takes a while: the glass scene at 640x480.
     let (mut slow, _, _) = job("scenes/glass.toml", 640, 480, AntiAliasing::Off);
     slow.preview = Some(preview);

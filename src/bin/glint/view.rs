@@ -74,6 +74,18 @@ pub struct ViewArgs {
     /// With --orbit-bench: pointer events per second (a mouse sends 60 to 125).
     #[arg(long, value_name = "HZ", default_value_t = 60.0, requires = "orbit_bench", value_parser = event_hz)]
     pub event_hz: f64,
+    /// With --orbit-bench: write each preview shown during the drag into
+    /// DIR as `preview_NNNN.png`, at the image's size as it was drawn, with
+    /// the record of the final image at its camera (`glint render
+    /// --from-png` renders what the preview stands for;
+    /// benches/orbit_previews.py compares the two).
+    #[arg(long, value_name = "DIR", requires = "orbit_bench")]
+    pub save_previews: Option<PathBuf>,
+    /// Start with the previews while moving coloured by where each pixel
+    /// came from: a fresh ray, a point reused from earlier frames (by
+    /// age), or filled from its neighbours (the render cache at work).
+    #[arg(long)]
+    pub preview_sources: bool,
     #[command(flatten)]
     pub rules: RulesArgs,
 }
@@ -106,6 +118,8 @@ impl Default for ViewArgs {
             compare_difference: false,
             orbit_bench: None,
             event_hz: 60.0,
+            save_previews: None,
+            preview_sources: false,
             rules: RulesArgs::default(),
         }
     }
@@ -125,6 +139,11 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     if let Some(shot) = &args.screenshot {
         glint::export::check_output(shot, args.scene.as_deref())
             .map_err(|e| anyhow!("--screenshot: {e}"))?;
+    }
+    // The previews' folder too, before the drag: not after minutes of it.
+    if let Some(dir) = &args.save_previews {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| anyhow!("--save-previews {}: cannot create it: {e}", dir.display()))?;
     }
     let (min_w, min_h) = glint::limits::MIN_WINDOW;
     anyhow::ensure!(
@@ -181,10 +200,12 @@ pub fn run(args: &ViewArgs) -> Result<()> {
             CompareArg::Aa => CompareSetting::AntiAliasing,
         }),
         compare_difference: args.compare_difference,
+        show_sources: args.preview_sources,
         orbit_bench: args.orbit_bench.map(|seconds| {
             glint::viewer::orbit_bench::OrbitBenchOptions {
                 seconds,
                 event_hz: args.event_hz,
+                save_previews: args.save_previews.clone(),
             }
         }),
     };

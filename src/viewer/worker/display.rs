@@ -49,6 +49,10 @@ pub struct FrameSource {
     pub scene: Arc<Scene>,
     pub camera: CameraSpec,
     pub settings: RenderSettings,
+    /// The settings of the frame the pass belongs to: `settings` itself
+    /// for a full pass, the frame a drag preview stands for (its size,
+    /// samples and depth) for a preview.
+    pub frame_settings: RenderSettings,
 }
 
 impl std::fmt::Debug for FrameSource {
@@ -91,6 +95,7 @@ impl Display<'_> {
             scene: Arc::clone(&self.job.scene),
             camera: self.job.camera,
             settings,
+            frame_settings: self.job.settings,
         }
     }
 }
@@ -178,6 +183,7 @@ impl PassWatch for Display<'_> {
                 max_depth: self.settings.max_depth,
                 protocol: self.settings.protocol,
                 from_cache: false,
+                reuse: None,
             });
             if self.job.preview.is_none()
                 && let Some(&record) = history.last()

@@ -19,10 +19,16 @@ pub struct Job {
     pub bvh: Option<Arc<Bvh>>,
     pub camera: CameraSpec,
     pub settings: RenderSettings,
-    /// Render only a quick 1-sample pass (while the user drags), at
-    /// 1/`divisor` of the resolution and as simplified as the frame budget
-    /// chose; `None`: the full progressive sequence.
+    /// A preview while the user moves the camera, a light or a material:
+    /// the render cache's, or a quick reduced 1-sample pass as simplified
+    /// as the frame budget chose; `None`: the full progressive sequence.
     pub preview: Option<Preview>,
+    /// The frame budget while moving (the viewer's setting): a
+    /// render-cache preview aims at three quarters of it.
+    pub frame_budget_ms: f64,
+    /// Show a render-cache preview coloured by where each pixel came from
+    /// (fresh ray, reused point by age, filled) instead of the picture.
+    pub show_sources: bool,
     /// The caller's number for the input this job reflects (the viewer
     /// counts pointer events), carried to the display buffer so the UI
     /// can tell how new a shown frame is.

@@ -78,4 +78,6 @@ pub struct PassRecord {
     /// Shown from the pass cache, not rendered again: `seconds` is the
     /// time the pass took when it was rendered.
     pub from_cache: bool,
+    /// For a render-cache preview: what it was made of.
+    pub reuse: Option<crate::render::render_cache::PreviewSummary>,
 }

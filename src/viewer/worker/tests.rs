@@ -6,21 +6,21 @@ use crate::stats::RayCounts;
 
 #[test]
 fn passes_describe_what_they_dropped() {
-    let preview = Preview {
+    let preview = Reduced {
         divisor: 2,
         reflections: Reflections::Off,
         shadows: true,
     };
     assert_eq!(
-        ShownPass::drag_preview(preview).label(),
+        ShownPass::drag_preview(Preview::Reduced(preview)).label(),
         "preview 1/2, no reflections"
     );
-    let one = Preview {
+    let one = Reduced {
         reflections: Reflections::OneBounce,
         ..preview
     };
     assert_eq!(one.describe(), "1/2, one bounce");
-    let bare = Preview {
+    let bare = Reduced {
         divisor: 1,
         reflections: Reflections::Off,
         shadows: false,
@@ -28,6 +28,10 @@ fn passes_describe_what_they_dropped() {
     assert_eq!(
         bare.describe(),
         "full resolution, no reflections, no shadows"
+    );
+    assert_eq!(
+        ShownPass::drag_preview(Preview::Reuse).label(),
+        "preview render cache"
     );
 }
 
@@ -38,11 +42,11 @@ fn the_history_keeps_full_passes_and_the_newest_previews() {
     let record = |generation: u64, preview: bool| PassRecord {
         generation,
         kind: if preview {
-            ShownPass::drag_preview(Preview {
+            ShownPass::drag_preview(Preview::Reduced(Reduced {
                 divisor: 2,
                 reflections: Reflections::Off,
                 shadows: false,
-            })
+            }))
         } else {
             ShownPass::full(Engine::OneSample)
         },
@@ -59,6 +63,7 @@ fn the_history_keeps_full_passes_and_the_newest_previews() {
         max_depth: 5,
         protocol: crate::settings::Protocol::Glint,
         from_cache: false,
+        reuse: None,
     };
     let mut history = History::default();
     let extra = 10;

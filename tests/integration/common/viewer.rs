@@ -65,6 +65,8 @@ pub fn job(
         camera: scene.camera,
         settings,
         preview: None,
+        frame_budget_ms: 33.0,
+        show_sources: false,
         serial: 0,
     };
     (job, scene, octree)
