@@ -543,17 +543,26 @@ fn multi_scene_commands_check_first_and_keep_same_names_apart() {
     let tmp = common::temp_dir();
     let sphere = common::repo_path("scenes/sphere.toml");
     let missing = tmp.path().join("missing.toml");
-    for command in ["bench", "study"] {
+    // A file that exists but is not a scene: found only by reading it.
+    let broken = tmp.path().join("broken.toml");
+    std::fs::write(&broken, "[camera]\neye = [0, 0\n").unwrap();
+    for (command, bad) in [
+        ("bench", &missing),
+        ("study", &missing),
+        ("bench", &broken),
+        ("study", &broken),
+    ] {
         let mut cmd = Command::new(env!("CARGO_BIN_EXE_glint"));
-        cmd.args([command, sphere.to_str().unwrap(), missing.to_str().unwrap()])
+        cmd.args([command, sphere.to_str().unwrap(), bad.to_str().unwrap()])
             .args(["--size", "8x6", "--repeat", "1"]);
         if command == "study" {
             cmd.arg("--out").arg(tmp.path().join("study"));
         }
         let out = cmd.output().unwrap();
         let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(1), "{command}: {err}");
-        assert!(err.contains("missing.toml"), "{command}: {err}");
+        let name = bad.file_name().unwrap().to_str().unwrap();
+        assert_eq!(out.status.code(), Some(1), "{command} {name}: {err}");
+        assert!(err.contains(name), "{command}: {err}");
         assert!(
             !err.contains(&format!("{command} {}", sphere.display())),
             "{command} timed first: {err}"
@@ -581,6 +590,37 @@ fn multi_scene_commands_check_first_and_keep_same_names_apart() {
     );
     assert!(out_dir.join("sphere-aa-need.png").exists());
     assert!(out_dir.join("sphere-2-aa-need.png").exists());
+}
+
+/// `glint --help` says that a scene alone opens the viewer.
+#[cfg(feature = "gui")]
+#[test]
+fn help_says_a_scene_alone_opens_the_viewer() {
+    let out = glint(&["--help"]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("`glint SCENE` (no command) opens SCENE in the viewer"),
+        "{text}"
+    );
+}
+
+/// A negative number where a positive one is asked for is refused as a
+/// value, not taken for an unknown flag.
+#[test]
+fn negative_numbers_are_refused_as_values() {
+    let sphere = scene();
+    for flags in [
+        &["render", &sphere, "--width", "-5", "-o", "-"][..],
+        &["render", &sphere, "--samples", "-1", "-o", "-"][..],
+        &["bench", &sphere, "--repeat", "-2"][..],
+    ] {
+        let out = glint(flags);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{flags:?}: {err}");
+        assert!(err.contains("got `-"), "{flags:?}: {err}");
+        assert!(!err.contains("use '--"), "{flags:?}: {err}");
+    }
 }
 
 /// Flags that would have no effect are refused with the flag they need,

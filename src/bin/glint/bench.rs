@@ -25,7 +25,7 @@ pub struct BenchArgs {
     pub size: Option<(u32, u32)>,
     /// Rays per pixel: 1 or 16 (default: each scene's own); the SPD
     /// protocol shoots the pixel corners instead.
-    #[arg(long, value_parser = parse_samples)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_samples)]
     pub samples: Option<u32>,
     /// Anti-aliasing: off, adaptive or full (see `glint render --aa`).
     #[arg(long, value_parser = crate::common::parse_aa, conflicts_with = "samples")]
@@ -36,7 +36,7 @@ pub struct BenchArgs {
     #[command(flatten)]
     pub rules: RulesArgs,
     /// Timed runs of each configuration; medians are reported.
-    #[arg(long, default_value_t = 3, value_parser = parse_positive)]
+    #[arg(long, default_value_t = 3, allow_negative_numbers = true, value_parser = parse_positive)]
     pub repeat: u32,
     #[command(flatten)]
     pub octree_params: OctreeArgs,

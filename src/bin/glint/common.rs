@@ -76,8 +76,10 @@ pub fn load_scene(path: &Path) -> Result<(Scene, f64)> {
 }
 
 /// Checks, before any scene is timed, that every scene file of a
-/// multi-scene command can be opened, so a mistyped last name fails at
-/// once rather than after the others were measured (and with no results).
+/// multi-scene command can be opened and read as a scene, so a mistyped
+/// or broken last file fails at once rather than after the others were
+/// measured (and with no results). A single scene is only opened here:
+/// the command reads it next anyway.
 pub fn check_scene_files(paths: &[std::path::PathBuf]) -> Result<()> {
     for path in paths {
         let kind = std::fs::metadata(path)
@@ -87,6 +89,16 @@ pub fn check_scene_files(paths: &[std::path::PathBuf]) -> Result<()> {
             "cannot read scene file {}: not a regular file",
             path.display()
         );
+    }
+    if paths.len() > 1 {
+        for path in paths {
+            glint::scene::load(path).with_context(|| {
+                format!(
+                    "nothing was timed: {} cannot be read as a scene",
+                    path.display()
+                )
+            })?;
+        }
     }
     Ok(())
 }
@@ -274,11 +286,11 @@ pub fn ray_depth(text: &str) -> Result<u32, String> {
 #[derive(clap::Args, Clone, Copy, Debug, Default)]
 pub struct OctreeArgs {
     /// Deepest octree level (root = 0; at most 21).
-    #[arg(long, value_parser = octree_depth)]
+    #[arg(long, allow_negative_numbers = true, value_parser = octree_depth)]
     pub octree_max_depth: Option<u32>,
     /// References up to which a node stays a leaf (default: 8 for a large
     /// mesh, at least 20,000 triangles; 4 otherwise).
-    #[arg(long, value_parser = parse_positive)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_positive)]
     pub octree_leaf_size: Option<u32>,
     /// Let the surface-area cost estimate stop subdivision early.
     #[arg(long, value_enum)]

@@ -46,6 +46,13 @@ use clap::{Parser, Subcommand};
     version,
     about = "An interactive Whitted-style ray tracer"
 )]
+#[cfg_attr(
+    feature = "gui",
+    command(
+        after_help = "`glint SCENE` (no command) opens SCENE in the viewer, as \
+                          `glint view SCENE` does; `glint` alone opens the built-in default scene."
+    )
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -81,6 +88,11 @@ fn main() -> std::process::ExitCode {
     // unusual platform) the signal's default stands.
     let _ = ctrlc::set_handler(|| {
         glint::export::remove_unfinished_outputs();
+        // The progress bar's line is still open: end it, so the shell's
+        // prompt starts on a line of its own.
+        if std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+            say!("");
+        }
         std::process::exit(130);
     });
     let cli = Cli::parse_from(with_default_command(std::env::args_os().collect()));

@@ -30,14 +30,14 @@ pub struct RenderArgs {
     /// Image width in pixels (default: the scene's). At most 32768 a side,
     /// 268,435,456 pixels in all, and what fits in 80% of the available
     /// memory (the estimate is checked before rendering).
-    #[arg(long, value_parser = parse_positive)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_positive)]
     pub width: Option<u32>,
     /// Image height in pixels (default: the scene's); limits as for --width.
-    #[arg(long, value_parser = parse_positive)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_positive)]
     pub height: Option<u32>,
     /// Rays per pixel: 1 (pixel centre) or 16 (regular 4x4 grid); the SPD
     /// protocol shoots the pixel corners instead.
-    #[arg(long, value_parser = parse_samples)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_samples)]
     pub samples: Option<u32>,
     /// Anti-aliasing: off (1 sample), full (the 4x4 grid in every pixel) or
     /// adaptive (every pixel's centre, then the 4x4 grid only where

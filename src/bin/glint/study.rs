@@ -34,7 +34,7 @@ pub struct StudyArgs {
     #[arg(long, default_value = "320x240", value_parser = parse_size)]
     pub size: (u32, u32),
     /// Timed runs per configuration (the median is reported).
-    #[arg(long, default_value_t = 3, value_parser = parse_positive)]
+    #[arg(long, default_value_t = 3, allow_negative_numbers = true, value_parser = parse_positive)]
     pub repeat: u32,
     /// Render threads (default: one per core; at most 8 per core).
     #[arg(long, default_value_t = 0, hide_default_value = true)]
