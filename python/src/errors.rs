@@ -79,6 +79,7 @@ pub fn load_error(py: Python<'_>, e: &LoadError) -> PyErr {
         ),
         LoadError::Io { path: p, .. }
         | LoadError::NotUtf8 { path: p, .. }
+        | LoadError::Png { path: p }
         | LoadError::Model { path: p, .. }
         | LoadError::UnknownFormat { path: p } => (
             Place {

@@ -217,6 +217,7 @@ fn private_chunk(
     if signature != *b"\x89PNG\r\n\x1a\n" {
         return Err(decode("not a PNG file"));
     }
+    let mut first = true;
     loop {
         let mut header = [0u8; 8];
         if file.read_exact(&mut header).is_err() {
@@ -224,6 +225,14 @@ fn private_chunk(
         }
         let length = u32::from_be_bytes([header[0], header[1], header[2], header[3]]);
         let chunk_type = [header[4], header[5], header[6], header[7]];
+        // A PNG's first chunk is its image header (PNG specification,
+        // 5.6); anything else is not a PNG, whatever its first bytes say.
+        if first && &chunk_type != b"IHDR" {
+            return Err(decode(
+                "damaged or not a PNG: it starts like one, but its first chunk is not the image header (IHDR)",
+            ));
+        }
+        first = false;
         if &chunk_type == b"IDAT" || &chunk_type == b"IEND" {
             return Ok(None);
         }
@@ -285,5 +294,20 @@ mod tests {
         // Whole, it reads on to the missing record: not truncated.
         let e = read_record_bytes(&bytes, path).unwrap_err().to_string();
         assert!(!e.contains("truncated"), "{e}");
+    }
+
+    #[test]
+    fn a_file_that_only_starts_like_a_png_is_said_in_words() {
+        // The signature, then text: no chunk type in Rust's debug form.
+        let mut bytes = b"\x89PNG\r\n\x1a\n".to_vec();
+        bytes.extend_from_slice(b"this is really not an image at all");
+        let e = read_record_bytes(&bytes, Path::new("fake.png"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("fake.png is not a readable PNG: damaged or not a PNG"),
+            "{e}"
+        );
+        assert!(!e.contains('{'), "{e}");
     }
 }

@@ -42,12 +42,20 @@ pub fn load_with(path: &Path, files: &dyn FileSource) -> Result<Scene, SceneErro
         path: path.to_owned(),
         source,
     })?;
+    if bytes.starts_with(PNG_SIGNATURE) {
+        return Err(SceneError::Png {
+            path: path.to_owned(),
+        });
+    }
     let text = String::from_utf8(bytes).map_err(|e| SceneError::NotUtf8 {
         path: path.to_owned(),
         offset: e.utf8_error().valid_up_to(),
     })?;
     load_str(&text, path, files)
 }
+
+/// The eight bytes every PNG file begins with (PNG specification, 5.2).
+const PNG_SIGNATURE: &[u8] = b"\x89PNG\r\n\x1a\n";
 
 fn extension(path: &Path) -> Option<String> {
     path.extension()

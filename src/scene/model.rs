@@ -412,6 +412,11 @@ pub enum SceneError {
     },
     #[error("{path} is not UTF-8 text (first bad byte at offset {offset})")]
     NotUtf8 { path: PathBuf, offset: usize },
+    #[error(
+        "{path} is a PNG image, not a scene; to render the scene a PNG of glint's was made \
+         from, use `glint render --from-png {path}` (`glint info {path}` says what it holds)"
+    )]
+    Png { path: PathBuf },
     #[error("{location}: {message}")]
     Invalid { location: Location, message: String },
     #[error("{location}: mesh {mesh}: {message}")]

@@ -600,7 +600,13 @@ pp 3
         let cut = &SCENE[..SCENE.find("-1 1 -2").unwrap()];
         let message = parse_str(cut).unwrap_err().to_string();
         assert!(
-            message.contains("t.nff:15:1: `p`: file ends while reading vertex"),
+            message.contains("t.nff:15:1: `p`: file ends at line 18 while reading vertex"),
+            "{message}"
+        );
+        // A viewpoint cut short names the line it still needed.
+        let message = parse_str("v\nfrom 0 0 5\n").unwrap_err().to_string();
+        assert!(
+            message.contains("t.nff:1:1: `v`: file ends at line 2 while reading its `at` line"),
             "{message}"
         );
         assert!(

@@ -430,14 +430,18 @@ fn add_object(
                         .iter()
                         .map(|m| m.name.as_str())
                         .collect();
+                    let defined = if known.is_empty() {
+                        format!(
+                            "the scene defines no materials: add a `[materials.{}]` table",
+                            name.get_ref()
+                        )
+                    } else {
+                        format!("defined: {}", known.join(", "))
+                    };
                     cx.error(
                         name.span(),
                         &key("material"),
-                        format!(
-                            "no material named `{}` (defined: {})",
-                            name.get_ref(),
-                            known.join(", ")
-                        ),
+                        format!("no material named `{}` ({defined})", name.get_ref()),
                     )
                 })? as u32,
         ),

@@ -393,6 +393,8 @@ fn malformed_inputs_are_clear_errors() {
     let cases: &[(&str, &[u8], &str)] = &[
         ("missing.toml", b"", "cannot read scene file"),
         ("binary.toml", b"\xff\xfe\x00camera", "is not UTF-8"),
+        // A render passed where its scene was meant.
+        ("render.png", b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR", "is a PNG image, not a scene; to render the scene a PNG of glint's was made from, use `glint render --from-png"),
         ("huge.nff", b"v\nfrom 0 0 1\nat 0 0 0\nup 0 1 0\nangle 40\nhither 1\nresolution 99999999 10\n", "resolution must be a whole number"),
         ("neg.nff", b"v\nfrom 0 0 1\nat 0 0 0\nup 0 1 0\nangle 40\nhither 1\nresolution 10 10\nf 1 1 1 1 0 0 0 1\ns 0 0 0 -0\n", "radius must not be zero"),
         ("needle.nff", b"v\nfrom 0 0 1\nat 0 0 0\nup 0 1 0\nangle 40\nhither 1\nresolution 10 10\nf 1 1 1 1 0 0 0 1\nc 0 3 0 0 5 6 0 -0\n", "needle.nff:9:1: `c`: cone radii must not both be zero"),

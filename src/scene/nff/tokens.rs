@@ -145,10 +145,18 @@ impl<'a> Tokens<'a> {
         }
     }
 
+    /// The next token, or an error at the entity being read naming what
+    /// it still needed and the line where the file ended.
     pub(super) fn next_token(&mut self, what: &str) -> Result<Token<'a>, SceneError> {
         self.advance().ok_or_else(|| {
             let (line, column, key) = self.entity;
-            self.error_at(line, column, key, format!("file ends while reading {what}"))
+            let last = self.scanner.text.lines().count().max(1);
+            self.error_at(
+                line,
+                column,
+                key,
+                format!("file ends at line {last} while reading {what}"),
+            )
         })
     }
 
@@ -241,7 +249,7 @@ impl<'a> Tokens<'a> {
     /// Reads the label of a `v` entity's line, e.g. `from`.
     pub(super) fn label(&mut self, expected: &str) -> Result<(), SceneError> {
         let key = self.entity.2;
-        let t = self.next_token(expected)?;
+        let t = self.next_token(&format!("its `{expected}` line"))?;
         if t.text == expected {
             Ok(())
         } else {

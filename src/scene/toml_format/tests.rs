@@ -150,6 +150,24 @@ fn errors_name_file_line_column_and_key() {
 }
 
 #[test]
+fn a_material_named_where_none_is_defined_says_how_to_define_it() {
+    let text = GOOD.replace("[materials.red]\ncolor = [1, 0, 0]\n", "");
+    let message = error_of(&text);
+    assert!(
+        message.contains(
+            "`objects[0].material`: no material named `red` (the scene defines no materials: \
+             add a `[materials.red]` table)"
+        ),
+        "{message}"
+    );
+    // With some defined, they are listed.
+    assert!(
+        error_of(&GOOD.replace("material = \"red\"", "material = \"blue\""))
+            .contains("(defined: red)")
+    );
+}
+
+#[test]
 fn image_limits_are_checked() {
     let with_image = |s: &str| format!("{GOOD}\n[image]\n{s}\n");
     assert!(
