@@ -14,22 +14,11 @@ use std::time::{Duration, Instant};
 
 use glint::camera::CameraSpec;
 use glint::image::frame::rgb_to_rgba;
+use glint::image::metrics::psnr_8bit;
 use glint::math::DVec3;
 use glint::render::Renderer;
 use glint::render::render_cache::{PreviewBudget, RenderCache};
 use glint::settings::AntiAliasing;
-
-fn psnr(a: &[u8], b: &[u8]) -> f64 {
-    let mse = a
-        .iter()
-        .zip(b)
-        .enumerate()
-        .filter(|(k, _)| k % 4 != 3)
-        .map(|(_, (&x, &y))| (f64::from(x) - f64::from(y)).powi(2))
-        .sum::<f64>()
-        / (a.len() / 4 * 3) as f64;
-    10.0 * (255.0f64.powi(2) / mse.max(1e-12)).log10()
-}
 
 fn orbit(c: &CameraSpec, angle: f64) -> CameraSpec {
     let axis = c.up.normalize();
@@ -118,7 +107,7 @@ fn main() {
             let (image, w, h) = cache.image();
             glint::render::render_cache::enlarge(image, (w, h), full, true, &mut enlarged);
             let (image, width, height) = (enlarged.as_slice(), full.0, full.1);
-            let db = psnr(image, &truth);
+            let db = psnr_8bit(image, &truth, 4);
             values.push(db);
             println!(
                 "frame {k:4}: {:6.1} ms (seed {:.1}, reproject {:.1}, rays {:.1}, fill {:.1}) {:5.2} dB  {}",

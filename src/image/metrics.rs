@@ -49,3 +49,39 @@ pub fn image_error(a: &[DVec3], reference: &[DVec3], colors: ColorConvention) ->
         visible_fraction: visible as f64 / a.len().max(1) as f64,
     }
 }
+
+/// The PSNR in dB of 8-bit image `a` against `reference`, over the colour
+/// channels (the first three bytes of every `stride`-byte pixel: 3 for
+/// RGB, 4 for RGBA); infinite for equal images.
+pub fn psnr_8bit(a: &[u8], reference: &[u8], stride: usize) -> f64 {
+    let (mut sum, mut n) = (0.0, 0usize);
+    for (p, q) in a.chunks_exact(stride).zip(reference.chunks_exact(stride)) {
+        for c in 0..3 {
+            sum += (f64::from(p[c]) - f64::from(q[c])).powi(2);
+        }
+        n += 3;
+    }
+    if sum == 0.0 {
+        return f64::INFINITY;
+    }
+    10.0 * (255.0f64.powi(2) * n as f64 / sum).log10()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn psnr_of_one_level_everywhere_is_that_of_255_to_1() {
+        let a = [10u8, 20, 30, 255, 40, 50, 60, 255];
+        let mut b = a.map(|v| v + 1);
+        // The alpha byte does not count.
+        b[3] = 0;
+        b[7] = 7;
+        let expected = 20.0 * 255.0f64.log10();
+        assert!((psnr_8bit(&a, &b, 4) - expected).abs() < 1e-12);
+        let rgb = [10u8, 20, 30, 40, 50, 60];
+        assert!((psnr_8bit(&rgb, &rgb.map(|v| v - 1), 3) - expected).abs() < 1e-12);
+        assert_eq!(psnr_8bit(&a, &a, 4), f64::INFINITY);
+    }
+}

@@ -10,6 +10,7 @@ use std::time::Duration;
 use common::viewer::*;
 use glint::accel::Octree;
 use glint::image::frame::rgba_to_rgb;
+use glint::image::metrics::psnr_8bit;
 use glint::render::PassKind as Engine;
 use glint::render::Renderer;
 use glint::settings::AntiAliasing;
@@ -125,10 +126,10 @@ fn render_cache_previews_fill_the_image_and_the_passes_still_end_on_the_cli_fram
             .to_rgb8()
     };
     let truth = exact(&moving.camera);
-    let db = psnr(&shown, &truth);
+    let db = psnr_8bit(&shown, &truth, 3);
     // Closer to the picture at the new camera than the picture at the old
     // one is: the points moved with the view.
-    let old = psnr(&exact(&still.camera), &truth);
+    let old = psnr_8bit(&exact(&still.camera), &truth, 3);
     assert!(
         db > old + 2.0,
         "preview {db:.1} dB, old picture {old:.1} dB"
@@ -140,16 +141,6 @@ fn render_cache_previews_fill_the_image_and_the_passes_still_end_on_the_cli_fram
     let g = worker.submit(released);
     assert!(worker.wait_finished(g, WAIT));
     assert!(worker.with_buffer(|b| rgba_to_rgb(&b.rgba)) == truth);
-}
-
-fn psnr(a: &[u8], b: &[u8]) -> f64 {
-    let mse = a
-        .iter()
-        .zip(b)
-        .map(|(&x, &y)| (f64::from(x) - f64::from(y)).powi(2))
-        .sum::<f64>()
-        / a.len() as f64;
-    10.0 * (255.0f64.powi(2) / mse.max(1e-12)).log10()
 }
 
 /// While the user drags, previews asked for while one is in flight do not

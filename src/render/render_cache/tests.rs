@@ -121,14 +121,9 @@ fn assert_close_picture(a: &[u8], b: &[u8], tolerance: u8, share: f64, what: &st
     );
 }
 
+/// PSNR of RGBA8 pictures over their colour channels.
 fn psnr(a: &[u8], b: &[u8]) -> f64 {
-    let mse = a
-        .iter()
-        .zip(b)
-        .map(|(&x, &y)| (f64::from(x) - f64::from(y)).powi(2))
-        .sum::<f64>()
-        / a.len() as f64;
-    10.0 * (255.0f64.powi(2) / mse.max(1e-12)).log10()
+    crate::image::metrics::psnr_8bit(a, b, 4)
 }
 
 fn no_time() -> PreviewBudget {
