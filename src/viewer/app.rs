@@ -726,10 +726,18 @@ impl GlintApp {
         self.edit.snapshot().differs_in_saved_values(&self.saved)
     }
 
-    /// The window title: the scene, marked while it has unsaved edits.
+    /// The window title: the scene, marked while it has unsaved edits, and
+    /// saying so when only the camera moved (an orbit is an edit too).
     fn title_logic(&mut self, ctx: &egui::Context) {
-        let mark = if self.unsaved() { "● " } else { "" };
-        let title = format!("{mark}{} — glint", self.edit.source.display_name());
+        let now = self.edit.snapshot();
+        let name = self.edit.source.display_name();
+        let title = if !now.differs_in_saved_values(&self.saved) {
+            format!("{name} — glint")
+        } else if now.differs_only_in_camera(&self.saved) {
+            format!("● {name} (camera moved) — glint")
+        } else {
+            format!("● {name} — glint")
+        };
         if title != self.title {
             ctx.send_viewport_cmd(egui::ViewportCommand::Title(title.clone()));
             self.title = title;

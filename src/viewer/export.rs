@@ -22,7 +22,7 @@ pub fn choose_path(source: &SceneSource) -> Option<PathBuf> {
     } else {
         // No dialog (no desktop portal, e.g. under Xvfb): never the working
         // directory, which is often a checkout.
-        Some(unused_path(&export_dir(source), &default_name))
+        Some(unused_path(&export_dir(), &default_name))
     }
 }
 
@@ -150,10 +150,19 @@ fn utc_timestamp(secs: u64) -> String {
 
 /// Where exports go without a file dialog: the user's pictures directory
 /// (`XDG_PICTURES_DIR`, from the environment or `~/.config/user-dirs.dirs`,
-/// else `~/Pictures`) if it exists, else the scene file's directory, else
-/// the temporary directory.
-pub(super) fn export_dir(source: &SceneSource) -> PathBuf {
-    let home = std::env::var_os("HOME").map(PathBuf::from);
+/// else `~/Pictures`) if it exists, else glint's folder in the user's data
+/// directory (`$XDG_DATA_HOME/glint/exports`, else
+/// `~/.local/share/glint/exports`, made if need be), else the temporary
+/// directory. Never the working directory nor the scene's folder: either
+/// is often a checkout, where an export would lie about as an untracked
+/// file.
+pub(super) fn export_dir() -> PathBuf {
+    export_dir_with(|name| std::env::var_os(name))
+}
+
+/// [`export_dir`] with the environment read through `var`.
+fn export_dir_with(var: impl Fn(&str) -> Option<std::ffi::OsString>) -> PathBuf {
+    let home = var("HOME").map(PathBuf::from);
     let from_user_dirs = || {
         let home = home.as_ref()?;
         let text = std::fs::read_to_string(home.join(".config/user-dirs.dirs")).ok()?;
@@ -165,24 +174,21 @@ pub(super) fn export_dir(source: &SceneSource) -> PathBuf {
             value.replace("$HOME", &home.to_string_lossy()),
         ))
     };
-    let pictures = std::env::var_os("XDG_PICTURES_DIR")
+    let pictures = var("XDG_PICTURES_DIR")
         .map(PathBuf::from)
         .or_else(from_user_dirs)
         .or_else(|| home.as_ref().map(|h| h.join("Pictures")));
     if let Some(dir) = pictures.filter(|d| d.is_dir()) {
         return dir;
     }
-    if let SceneSource::File(p) = source {
-        // A bare name (`glint view sphere.toml`) is in the working folder.
-        let dir = match p.parent() {
-            Some(d) if !d.as_os_str().is_empty() => d,
-            _ => Path::new("."),
-        };
-        if let Ok(dir) = std::fs::canonicalize(dir)
-            && dir.is_dir()
-        {
-            return dir;
-        }
+    let data = var("XDG_DATA_HOME")
+        .map(PathBuf::from)
+        .filter(|d| d.is_absolute())
+        .or_else(|| home.as_ref().map(|h| h.join(".local/share")));
+    if let Some(dir) = data.map(|d| d.join("glint").join("exports"))
+        && std::fs::create_dir_all(&dir).is_ok()
+    {
+        return dir;
     }
     std::env::temp_dir()
 }
@@ -197,6 +203,19 @@ mod tests {
         // 2000-02-29 (a leap day) 12:34:56 and 2026-11-23 14:05:09.
         assert_eq!(utc_timestamp(951_827_696), "2000-02-29T12-34-56Z");
         assert_eq!(utc_timestamp(1_795_442_709), "2026-11-23T14-05-09Z");
+    }
+
+    #[test]
+    fn without_a_pictures_folder_exports_go_to_glints_data_folder() {
+        // Never the scene's folder or the working one (often a checkout).
+        let home = tempfile::tempdir().unwrap();
+        let env = |name: &str| (name == "HOME").then(|| home.path().as_os_str().to_owned());
+        let dir = export_dir_with(env);
+        assert_eq!(dir, home.path().join(".local/share/glint/exports"));
+        assert!(dir.is_dir());
+        // A pictures folder, where there is one.
+        std::fs::create_dir(home.path().join("Pictures")).unwrap();
+        assert_eq!(export_dir_with(env), home.path().join("Pictures"));
     }
 
     #[test]

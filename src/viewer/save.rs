@@ -34,14 +34,14 @@ pub(super) fn is_nff(source: &SceneSource) -> bool {
 /// Where "Save scene as" writes: chosen in a save dialog, or, without one,
 /// a new name beside the scene file (`NAME-edited.toml`, then
 /// `NAME-edited-2.toml`, ...); the built-in scene, which has no file, goes
-/// where exports go (the pictures directory, else the temporary one), never
-/// into the working directory, often a checkout. `None` when the user
+/// where exports go ([`super::export::export_dir`]), never into the working
+/// directory, often a checkout. `None` when the user
 /// cancels.
 pub fn choose_path(source: &SceneSource) -> Option<PathBuf> {
     let folder = match source.path().and_then(Path::parent) {
         Some(d) if !d.as_os_str().is_empty() => d.to_owned(),
         Some(_) => PathBuf::from("."),
-        None => super::export::export_dir(source),
+        None => super::export::export_dir(),
     };
     // A copy of a copy is `NAME-edited-2`, not `NAME-edited-edited`.
     let stem = unedited_stem(&source.stem());

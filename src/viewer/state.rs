@@ -171,6 +171,16 @@ impl Snapshot {
             || self.octree != other.octree
             || saved(self) != saved(other)
     }
+
+    /// Whether the camera is the only saved value `self` and `other`
+    /// differ in (an orbit, nothing else edited).
+    pub fn differs_only_in_camera(&self, other: &Snapshot) -> bool {
+        let same_camera = Snapshot {
+            camera: other.camera,
+            ..self.clone()
+        };
+        self.camera != other.camera && !same_camera.differs_in_saved_values(other)
+    }
 }
 
 impl EditState {

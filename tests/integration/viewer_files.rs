@@ -19,6 +19,19 @@ fn edits_undo_redo_save_and_a_reload_that_asks() {
     let mut h = harness(app);
     assert!(!h.state().unsaved());
     assert!(!h.state().title().starts_with('●'), "{}", h.state().title());
+    // An orbit alone is an edit the title names.
+    let camera = *h.state().camera();
+    h.state_mut().camera_mut().eye.x += 1.0;
+    h.run_steps(2);
+    assert!(h.state().title().starts_with('●'), "{}", h.state().title());
+    assert!(
+        h.state().title().contains("(camera moved)"),
+        "{}",
+        h.state().title()
+    );
+    *h.state_mut().camera_mut() = camera;
+    h.run_steps(2);
+    assert!(!h.state().unsaved(), "{}", h.state().title());
     let original = h.state().scene().lights.clone();
     let edited = glint::math::DVec3::new(0.25, 0.5, 0.75);
     h.state_mut().scene_mut().lights[0].color = edited;
@@ -26,6 +39,11 @@ fn edits_undo_redo_save_and_a_reload_that_asks() {
     h.run_steps(2);
     assert!(h.state().unsaved());
     assert!(h.state().title().starts_with('●'), "{}", h.state().title());
+    assert!(
+        !h.state().title().contains("camera"),
+        "{}",
+        h.state().title()
+    );
 
     press(&mut h, Modifiers::COMMAND, Key::Z);
     assert_eq!(
