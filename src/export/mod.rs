@@ -21,7 +21,8 @@ use std::path::Path;
 
 pub use error::ExportError;
 pub use output::{
-    OutputTarget, check_output, remove_unfinished_outputs, save_rgb_png, write_file_atomically,
+    OutputTarget, check_output, remove_unfinished_outputs, replaced_non_png, save_rgb_png,
+    write_file_atomically,
 };
 pub use png_file::{read_record, read_record_bytes};
 pub use record::{

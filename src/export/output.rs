@@ -115,6 +115,42 @@ pub fn check_output(path: &Path, input: Option<&Path>) -> Result<OutputTarget, E
     Ok(target)
 }
 
+/// What an output file about to be replaced holds when it is not a PNG
+/// image (a name ending `.png` does not make one): e.g. "1,234 bytes of
+/// text", for a note before it is replaced. `None` for a PNG, a file not
+/// yet there, or one that cannot be read.
+pub fn replaced_non_png(target: &OutputTarget) -> Option<String> {
+    use std::io::Read;
+    let file = target.file()?;
+    let mut head = [0u8; 8];
+    let mut f = std::fs::File::open(file).ok()?;
+    let size = f.metadata().ok()?.len();
+    let n = f.read(&mut head).ok()?;
+    if size == 0 || head[..n] == *b"\x89PNG\r\n\x1a\n" {
+        return None;
+    }
+    let text = std::str::from_utf8(&head[..n]).is_ok_and(|t| !t.contains('\0'));
+    let what = if text {
+        "text"
+    } else {
+        "data that is not a PNG image"
+    };
+    Some(format!("{} bytes of {what}", group_thousands(size)))
+}
+
+/// `1234567` as "1,234,567".
+fn group_thousands(n: u64) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (k, c) in digits.chars().enumerate() {
+        if k > 0 && (digits.len() - k).is_multiple_of(3) {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
 /// Temporary files being written: an interrupted process (Ctrl+C runs no
 /// destructors) removes them with [`remove_unfinished_outputs`].
 static UNFINISHED: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
@@ -317,6 +353,27 @@ mod tests {
 
     // Removal itself is `tests/integration/cli_output.rs`'s: calling it here would
     // remove other tests' files being written in parallel.
+    #[test]
+    fn a_file_about_to_be_replaced_that_is_not_a_png_is_described() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("notes.png");
+        let target = |p: &Path| OutputTarget::resolve(p).unwrap();
+        assert_eq!(replaced_non_png(&target(&path)), None, "not there yet");
+        std::fs::write(&path, "my notes\n".repeat(200)).unwrap();
+        assert_eq!(
+            replaced_non_png(&target(&path)).as_deref(),
+            Some("1,800 bytes of text")
+        );
+        std::fs::write(&path, [0xffu8, 0xd8, 0xff, 0xe0, 0, 0x10]).unwrap();
+        assert_eq!(
+            replaced_non_png(&target(&path)).as_deref(),
+            Some("6 bytes of data that is not a PNG image")
+        );
+        std::fs::write(&path, b"\x89PNG\r\n\x1a\n\0\0\0\rIHDR").unwrap();
+        assert_eq!(replaced_non_png(&target(&path)), None, "a PNG");
+        assert_eq!(replaced_non_png(&OutputTarget::Stdout), None);
+    }
+
     #[test]
     fn temporary_files_are_listed_while_written_and_forgotten_after() {
         let dir = tempfile::tempdir().unwrap();

@@ -592,6 +592,32 @@ fn multi_scene_commands_check_first_and_keep_same_names_apart() {
     assert!(out_dir.join("sphere-2-aa-need.png").exists());
 }
 
+/// `-o` onto an existing file that is not a PNG replaces it, saying so
+/// first.
+#[test]
+fn replacing_a_file_that_is_not_a_png_is_said() {
+    let tmp = common::temp_dir();
+    let out_path = tmp.path().join("out.png");
+    std::fs::write(&out_path, "not an image\n").unwrap();
+    let out = glint(&[
+        "render",
+        &scene(),
+        "--width",
+        "8",
+        "--height",
+        "6",
+        "-o",
+        out_path.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("out.png is not a PNG image (13 bytes of text); the render replaces it"),
+        "{err}"
+    );
+    assert!(std::fs::read(&out_path).unwrap().starts_with(b"\x89PNG"));
+}
+
 /// `glint --help` says that a scene alone opens the viewer.
 #[cfg(feature = "gui")]
 #[test]

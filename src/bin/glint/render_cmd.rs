@@ -172,6 +172,12 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
     if let Some(output) = &args.output {
         let input = args.scene.as_deref().or(args.from_png.as_deref());
         let target = glint::export::check_output(output, input)?;
+        if let Some(held) = glint::export::replaced_non_png(&target) {
+            say!(
+                "note: {} is not a PNG image ({held}); the render replaces it",
+                output.display()
+            );
+        }
         if target == glint::export::OutputTarget::Stdout {
             anyhow::ensure!(
                 !args.stats && args.trace_pixel.is_none(),
