@@ -2,15 +2,21 @@
 the intersection tests of every ray a pixel spawned.
 
     python python/examples/cost_view.py [SCENE] [OUTPUT_FOLDER]
+
+Without arguments it renders the repository's SPD teapot (found from this
+file, so it runs from any folder) and writes cost.png into the temporary
+folder, never into the working one (often the checkout).
 """
 
 import sys
+import tempfile
 from pathlib import Path
 
 import glint
 
-scene = glint.load(sys.argv[1] if len(sys.argv) > 1 else "scenes/spd/teapot.nff")
-out = Path(sys.argv[2] if len(sys.argv) > 2 else ".")
+REPO = Path(__file__).resolve().parents[2]
+scene = glint.load(sys.argv[1] if len(sys.argv) > 1 else REPO / "scenes" / "spd" / "teapot.nff")
+out = Path(sys.argv[2] if len(sys.argv) > 2 else tempfile.gettempdir())
 
 picture = scene.render(320, 240)
 cost = scene.render(320, 240, view="cost", stats=True)

@@ -2,13 +2,18 @@
 why its walk stopped.
 
     python python/examples/shadow_walk.py [SCENE] [X] [Y]
+
+Without a scene it walks the repository's default scene (found from this
+file, so it runs from any folder).
 """
 
 import sys
+from pathlib import Path
 
 import glint
 
-scene = glint.load(sys.argv[1] if len(sys.argv) > 1 else "scenes/default.toml")
+REPO = Path(__file__).resolve().parents[2]
+scene = glint.load(sys.argv[1] if len(sys.argv) > 1 else REPO / "scenes" / "default.toml")
 x, y = (int(sys.argv[2]), int(sys.argv[3])) if len(sys.argv) > 3 else (100, 110)
 trace = scene.trace_pixel(x, y, width=200, height=150)
 

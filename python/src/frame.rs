@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyByteArray, PyBytes};
 
@@ -130,7 +130,15 @@ impl PyFrame {
             record.settings.edits = self.edits.clone();
             glint::export::save_frame(&self.frame, &path, &mut record, None)
         })
-        .map_err(|e| export_error(&e))
+        .map_err(|e| match e {
+            // The command line's message offers `-` for standard output,
+            // which `save` refuses: `png()` gives the bytes instead.
+            glint::export::ExportError::NotPng { path } => PyOSError::new_err(format!(
+                "{}: save writes PNG images; name the file .png (png() returns the bytes)",
+                path.display()
+            )),
+            e => export_error(&e),
+        })
     }
 
     fn __repr__(&self) -> String {

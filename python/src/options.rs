@@ -24,6 +24,24 @@ pub struct RenderOptions<'a> {
     pub sides: Option<&'a str>,
 }
 
+/// A whole-number argument (`width`, `samples`, ...) as Python gave it,
+/// checked: a negative or too large one is a `ValueError` naming it (as
+/// the command line refuses `--width -5`), not the `OverflowError` of a
+/// conversion to an unsigned type.
+pub fn count(name: &str, value: Option<i64>) -> PyResult<Option<u32>> {
+    value
+        .map(|v| {
+            u32::try_from(v).map_err(|_| {
+                PyValueError::new_err(if v < 0 {
+                    format!("{name} must be a whole number of at least 0, got {v}")
+                } else {
+                    format!("{name} {v} is too large")
+                })
+            })
+        })
+        .transpose()
+}
+
 fn parsed<T: std::str::FromStr<Err = String>>(text: Option<&str>) -> PyResult<Option<T>> {
     text.map(str::parse)
         .transpose()

@@ -19,7 +19,7 @@ use glint::scene::{KeyValue, Scene};
 use crate::errors::{edit_error, octree_error, render_error};
 use crate::frame::PyFrame;
 use crate::interrupt::run_stoppable;
-use crate::options::{RenderOptions, thread_pool};
+use crate::options::{RenderOptions, count, thread_pool};
 
 /// A built octree kept for the renders after it: lights, materials and
 /// the camera change no cell, so only new parameters build another.
@@ -244,12 +244,12 @@ impl PyScene {
     #[allow(clippy::too_many_arguments)]
     fn render(
         slf: &Bound<'_, Self>,
-        width: Option<u32>,
-        height: Option<u32>,
-        samples: Option<u32>,
+        width: Option<i64>,
+        height: Option<i64>,
+        samples: Option<i64>,
         aa: Option<&str>,
         octree: Option<bool>,
-        max_depth: Option<u32>,
+        max_depth: Option<i64>,
         view: Option<&str>,
         threads: Option<usize>,
         stats: bool,
@@ -261,12 +261,12 @@ impl PyScene {
         let py = slf.py();
         let snap = snapshot(slf);
         let options = RenderOptions {
-            width,
-            height,
-            samples,
+            width: count("width", width)?,
+            height: count("height", height)?,
+            samples: count("samples", samples)?,
             aa,
             octree,
-            max_depth,
+            max_depth: count("max_depth", max_depth)?,
             view,
             protocol,
             colors,
@@ -338,20 +338,20 @@ impl PyScene {
         slf: &Bound<'_, Self>,
         x: u32,
         y: u32,
-        width: Option<u32>,
-        height: Option<u32>,
+        width: Option<i64>,
+        height: Option<i64>,
         octree: Option<bool>,
-        max_depth: Option<u32>,
+        max_depth: Option<i64>,
         protocol: Option<&str>,
         colors: Option<&str>,
         sides: Option<&str>,
     ) -> PyResult<String> {
         let snap = snapshot(slf);
         let options = RenderOptions {
-            width,
-            height,
+            width: count("width", width)?,
+            height: count("height", height)?,
             octree,
-            max_depth,
+            max_depth: count("max_depth", max_depth)?,
             protocol,
             colors,
             sides,
@@ -424,11 +424,11 @@ impl PyScene {
     #[allow(clippy::too_many_arguments)]
     fn bench(
         slf: &Bound<'_, Self>,
-        width: Option<u32>,
-        height: Option<u32>,
-        samples: Option<u32>,
+        width: Option<i64>,
+        height: Option<i64>,
+        samples: Option<i64>,
         aa: Option<&str>,
-        max_depth: Option<u32>,
+        max_depth: Option<i64>,
         view: Option<&str>,
         protocol: Option<&str>,
         colors: Option<&str>,
@@ -444,11 +444,11 @@ impl PyScene {
         }
         let snap = snapshot(slf);
         let options = RenderOptions {
-            width,
-            height,
-            samples,
+            width: count("width", width)?,
+            height: count("height", height)?,
+            samples: count("samples", samples)?,
             aa,
-            max_depth,
+            max_depth: count("max_depth", max_depth)?,
             view,
             protocol,
             colors,

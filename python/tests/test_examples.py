@@ -9,11 +9,20 @@ from conftest import REPO
 EXAMPLES = REPO / "python" / "examples"
 
 
-def run(script, *args):
+def run(script, *args, cwd=REPO):
     done = subprocess.run([sys.executable, str(EXAMPLES / script), *map(str, args)],
-                          cwd=REPO, capture_output=True, text=True, timeout=300)
+                          cwd=cwd, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     return done.stdout
+
+
+def test_examples_without_arguments_run_from_any_folder_and_write_nothing_there(tmp_path):
+    # From a folder that is not the checkout: the scenes are found from
+    # the script, and cost.png goes to the temporary folder.
+    out = run("cost_view.py", cwd=tmp_path)
+    assert "intersection tests per ray" in out
+    assert "the eye ray hits plane 0 (floor)" in run("shadow_walk.py", cwd=tmp_path)
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_cost_view_reports_the_cost_and_writes_a_picture(tmp_path):

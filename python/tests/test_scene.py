@@ -154,5 +154,12 @@ def test_settings_outside_the_limits_are_refused():
             scene.render(**kwargs)
     with pytest.raises(ValueError, match="outside the 8x8 image"):
         scene.trace_pixel(8, 0, width=8, height=8)
-    with pytest.raises(OSError, match="png"):
+    with pytest.raises(OSError, match="name the file .png") as e:
         scene.render(4, 4).save("picture.jpg")
+    assert "standard output" not in str(e.value)
+    # Negative sizes are refused as values, as the command line refuses them.
+    for kwargs in [{"width": -1, "height": 10}, {"samples": -1}, {"max_depth": -3}]:
+        with pytest.raises(ValueError, match="at least 0, got -"):
+            scene.render(**kwargs)
+    with pytest.raises(ValueError, match="width must be"):
+        scene.trace_pixel(0, 0, width=-8, height=8)
