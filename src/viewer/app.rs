@@ -73,7 +73,7 @@ pub struct GlintApp {
     /// An action that would drop unsaved edits, waiting for the user's word.
     discarding: Option<Discarding>,
     /// The path typed where no file dialog is available (Ctrl+O).
-    open_prompt: Option<scene_files::OpenPrompt>,
+    path_prompt: Option<scene_files::PathPrompt>,
     /// The window title last sent.
     title: String,
     /// How the image is scaled into its panel.
@@ -153,7 +153,7 @@ impl GlintApp {
             undoer: Default::default(),
             saved,
             discarding: None,
-            open_prompt: None,
+            path_prompt: None,
             title: String::new(),
             magnification: Magnification::default(),
             octree: Arc::new(octree),
@@ -416,7 +416,7 @@ impl GlintApp {
             });
         egui::CentralPanel::default_margins().show(ui, |ui| commands.extend(self.image_ui(ui)));
         self.discard_prompt_ui(&ctx);
-        self.open_prompt_ui(&ctx);
+        self.path_prompt_ui(&ctx);
         self.apply(commands, &ctx);
         self.sync_octree();
         self.octree_tuning_logic(&ctx);
@@ -761,21 +761,6 @@ impl GlintApp {
     /// The ray whose octree walk is shown, and how many steps.
     pub fn walk(&self) -> (Option<&WalkTarget>, usize) {
         (self.inspect.walk.target.as_ref(), self.inspect.walk.shown)
-    }
-
-    /// Writes the displayed frame to a PNG chosen in a save dialog, or, where
-    /// no dialog is available, to the pictures directory.
-    pub fn export(&mut self) {
-        let Some(path) = export::choose_path(&self.edit.source) else {
-            return;
-        };
-        match self.export_to(&path) {
-            Ok(()) => {
-                let shown = std::path::absolute(&path).unwrap_or(path);
-                self.say(format!("exported {}", shown.display()), false)
-            }
-            Err(e) => self.say(format!("export to {} failed: {e:#}", path.display()), true),
-        }
     }
 }
 

@@ -371,3 +371,74 @@ fn ctrl_o_without_a_dialog_offers_a_path_field() {
         h.state().scene().name
     );
 }
+
+/// Without a file dialog, Save as and Export show a path field filled in
+/// with the name glint would choose: Enter takes it, or another folder can
+/// be typed (a built-in scene's copy need not go where a file is in the
+/// way).
+#[test]
+fn save_as_and_export_without_a_dialog_offer_a_filled_in_path_field() {
+    use egui::{Key, Modifiers};
+    if glint::viewer::file_dialog_available() {
+        eprintln!("a desktop portal is available here: the field is not shown");
+        return;
+    }
+    let select_all = egui::Event::Key {
+        key: Key::A,
+        physical_key: None,
+        pressed: true,
+        repeat: false,
+        modifiers: Modifiers::COMMAND,
+    };
+    let (dir, path) = scene_in_temp_folder();
+    let mut h = harness(app_at(&path));
+    h.state_mut().scene_mut().lights[0].position.x += 1.0;
+    h.run_steps(2);
+    press(&mut h, Modifiers::COMMAND | Modifiers::SHIFT, Key::S);
+    h.get_by_label_contains("Save the scene as");
+    // Another folder, typed over the name offered; one that does not
+    // exist is refused first.
+    let other = dir.path().join("elsewhere");
+    h.run_steps(2);
+    h.event(select_all.clone());
+    h.event(egui::Event::Text(
+        other.join("copy.toml").display().to_string(),
+    ));
+    h.key_press(Key::Enter);
+    h.run_steps(3);
+    h.get_by_label_contains("no such folder");
+    std::fs::create_dir(&other).unwrap();
+    h.event(select_all.clone());
+    h.event(egui::Event::Text(
+        other.join("copy.toml").display().to_string(),
+    ));
+    h.key_press(Key::Enter);
+    h.run_steps(3);
+    assert!(
+        h.query_by_label_contains("Save the scene as").is_none(),
+        "the field closed"
+    );
+    let copy = glint::scene::load(&other.join("copy.toml")).unwrap();
+    assert_eq!(
+        copy.lights[0].position,
+        h.state().scene().lights[0].position
+    );
+    assert!(!h.state().unsaved(), "{:?}", h.state().messages().last());
+
+    // Export: the same field, a name typed over the one offered.
+    settle(&mut h);
+    press(&mut h, Modifiers::COMMAND, Key::E);
+    h.get_by_label_contains("Export the image");
+    h.run_steps(2);
+    h.event(select_all);
+    let png = other.join("picture.png");
+    h.event(egui::Event::Text(png.display().to_string()));
+    h.key_press(Key::Enter);
+    h.run_steps(3);
+    assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
+    let said = &h.state().messages().last().unwrap().text;
+    assert!(
+        said.starts_with("exported ") && said.contains("picture.png"),
+        "{said}"
+    );
+}

@@ -77,9 +77,16 @@ impl GlintApp {
 
     /// Writes the scene with its edits to a new file (NFF for an NFF
     /// scene, TOML otherwise) and goes on editing that file.
+    /// Without a file dialog, a path field filled in with the name glint
+    /// would choose (beside the scene, or where exports go), so another
+    /// folder can be named.
     pub fn save_as(&mut self) {
         if let Some(path) = save::choose_path(&self.edit.source) {
-            self.save_to(&path);
+            if export::file_dialog_available() {
+                self.save_to(&path);
+            } else {
+                self.path_prompt = Some(PathPrompt::new(PromptFor::SaveAs, Some(&path)));
+            }
         }
     }
 
@@ -229,7 +236,7 @@ impl GlintApp {
     pub(super) fn open_dialog(&mut self) {
         if !export::file_dialog_available() {
             // A path field instead (Xvfb, minimal desktops).
-            self.open_prompt = Some(OpenPrompt::default());
+            self.path_prompt = Some(PathPrompt::new(PromptFor::Open, None));
             return;
         }
         if let Some(path) = rfd::FileDialog::new()
@@ -248,27 +255,74 @@ impl GlintApp {
         }
     }
 
-    /// Where no file dialog is available: a field for the scene's path,
-    /// checked before it is opened.
-    pub(super) fn open_prompt_ui(&mut self, ctx: &egui::Context) {
-        let Some(prompt) = &mut self.open_prompt else {
+    /// Writes the displayed frame to a PNG chosen in a save dialog, or,
+    /// where no dialog is available, named in a path field filled in with
+    /// a timestamped name where exports go ([`export::choose_path`]).
+    pub fn export(&mut self) {
+        let Some(path) = export::choose_path(&self.edit.source) else {
+            return;
+        };
+        if export::file_dialog_available() {
+            self.export_at(path);
+        } else {
+            // A field filled in with the name chosen, so another can be given.
+            let prompt = PathPrompt::new(PromptFor::Export, Some(&path));
+            self.path_prompt = Some(prompt);
+        }
+    }
+
+    /// Exports to `path` and says where it went.
+    pub(super) fn export_at(&mut self, path: PathBuf) {
+        match self.export_to(&path) {
+            Ok(()) => {
+                let shown = std::path::absolute(&path).unwrap_or(path);
+                self.say(format!("exported {}", shown.display()), false)
+            }
+            Err(e) => self.say(format!("export to {} failed: {e:#}", path.display()), true),
+        }
+    }
+
+    /// Where no file dialog is available: a field for the path to open,
+    /// save as or export to (the latter two filled in with the name glint
+    /// would choose), checked before it is used.
+    pub(super) fn path_prompt_ui(&mut self, ctx: &egui::Context) {
+        let Some(prompt) = &mut self.path_prompt else {
             return;
         };
         let mut chosen = None;
         let mut cancel = false;
-        egui::Modal::new(egui::Id::unique("open-scene")).show(ctx, |ui| {
-            ui.heading("Open a scene");
-            ui.label(
-                "No file dialog is available here (no desktop portal). \
-                 Type the path of a scene (.toml, .nff or .obj):",
-            );
+        let (heading, ask, button, hint) = match prompt.purpose {
+            PromptFor::Open => (
+                "Open a scene",
+                "Type the path of a scene (.toml, .nff or .obj):",
+                "Open",
+                "scenes/glass.toml",
+            ),
+            PromptFor::SaveAs => (
+                "Save the scene as",
+                "Type the path of the new scene file (.toml, or .nff for an NFF scene):",
+                "Save",
+                "my-scene.toml",
+            ),
+            PromptFor::Export => (
+                "Export the image",
+                "Type the path of the PNG to write:",
+                "Export",
+                "picture.png",
+            ),
+        };
+        egui::Modal::new(egui::Id::unique("path-prompt")).show(ctx, |ui| {
+            ui.heading(heading);
+            ui.label(format!(
+                "No file dialog is available here (no desktop portal). {ask}"
+            ));
             if let Ok(dir) = std::env::current_dir() {
                 ui.weak(format!("relative to {}", dir.display()));
             }
             let field = ui.add(
                 egui::TextEdit::singleline(&mut prompt.text)
-                    .desired_width(420.0)
-                    .hint_text("scenes/glass.toml"),
+                    .desired_width(520.0)
+                    .hint_text(hint),
             );
             if !prompt.focused {
                 field.request_focus();
@@ -279,7 +333,7 @@ impl GlintApp {
                 ui.colored_label(ui.visuals().error_fg_color, error);
             }
             ui.horizontal(|ui| {
-                if ui.button("Open").clicked() || entered {
+                if ui.button(button).clicked() || entered {
                     chosen = Some(PathBuf::from(prompt.text.trim()));
                 }
                 if ui.button("Cancel").clicked() || ui.input(|i| i.key_pressed(egui::Key::Escape)) {
@@ -288,38 +342,70 @@ impl GlintApp {
             });
         });
         if cancel {
-            self.open_prompt = None;
+            self.path_prompt = None;
             return;
         }
         let Some(path) = chosen else { return };
+        let purpose = prompt.purpose;
+        let folder = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d.to_owned(),
+            _ => PathBuf::from("."),
+        };
         let refusal = if path.as_os_str().is_empty() {
             Some("type a path".to_owned())
-        } else if !path.is_file() {
+        } else if purpose == PromptFor::Open && !path.is_file() {
             Some(format!("{}: no such file", path.display()))
+        } else if purpose != PromptFor::Open && !folder.is_dir() {
+            Some(format!("{}: no such folder", folder.display()))
+        } else if purpose != PromptFor::Open && path.is_dir() {
+            Some(format!("{} is a folder: add a file name", path.display()))
         } else {
             None
         };
-        match refusal {
-            Some(error) => {
-                if let Some(prompt) = &mut self.open_prompt {
-                    prompt.error = Some(error);
-                    prompt.focused = false;
-                }
+        if let Some(error) = refusal {
+            if let Some(prompt) = &mut self.path_prompt {
+                prompt.error = Some(error);
+                prompt.focused = false;
             }
-            None => {
-                self.open_prompt = None;
-                self.open_asking_first(path);
-            }
+            return;
+        }
+        self.path_prompt = None;
+        match purpose {
+            PromptFor::Open => self.open_asking_first(path),
+            PromptFor::SaveAs => self.save_to(&path),
+            PromptFor::Export => self.export_at(path),
         }
     }
 }
 
-/// The Ctrl+O path field shown where no file dialog is available.
-#[derive(Debug, Default)]
-pub(super) struct OpenPrompt {
+/// What a path field asks for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum PromptFor {
+    Open,
+    SaveAs,
+    Export,
+}
+
+/// The path field shown for Open, Save as and Export where no file dialog
+/// is available.
+#[derive(Debug)]
+pub(super) struct PathPrompt {
+    purpose: PromptFor,
     text: String,
     /// Why the last path was refused.
     error: Option<String>,
     /// Focus was given to the field (once, so a click elsewhere stays).
     focused: bool,
+}
+
+impl PathPrompt {
+    /// A field for `purpose`, filled in with `path` (empty for Open).
+    pub(super) fn new(purpose: PromptFor, path: Option<&Path>) -> Self {
+        Self {
+            purpose,
+            text: path.map(|p| p.display().to_string()).unwrap_or_default(),
+            error: None,
+            focused: false,
+        }
+    }
 }
