@@ -31,10 +31,35 @@ pub fn choose_preview(
     settings: &RenderSettings,
     budget_ms: f64,
 ) -> Option<(Preview, f64)> {
-    if reuses(settings) {
+    if reuses(settings) && reuse_keeps_up(history, settings, budget_ms) {
         return Some((Preview::Reuse, reuse_seconds(budget_ms)));
     }
     choose_reduced(history, settings, budget_ms).map(|(p, t)| (Preview::Reduced(p), t))
+}
+
+/// How many times its aim the render cache's previews may take before the
+/// reduced previews are shown instead.
+const REUSE_OVERRUN: f64 = 2.0;
+
+/// Whether the render cache keeps up at this image size: the median of its
+/// last three previews of it within [`REUSE_OVERRUN`] times their aim (a
+/// large image on few cores can take several times the budget even at the
+/// cache's coarsest scale: its enlargement and upload alone are a frame's
+/// worth; the reduced previews then keep the motion fluid). Untried, it is
+/// given the chance.
+fn reuse_keeps_up(history: &[PassRecord], settings: &RenderSettings, budget_ms: f64) -> bool {
+    let mut recent: Vec<f64> = history
+        .iter()
+        .rev()
+        .filter(|r| r.reuse.is_some() && (r.width, r.height) == (settings.width, settings.height))
+        .take(3)
+        .map(|r| r.seconds)
+        .collect();
+    if recent.len() < 3 {
+        return true;
+    }
+    recent.sort_by(f64::total_cmp);
+    recent[1] <= REUSE_OVERRUN * reuse_seconds(budget_ms)
 }
 
 /// The reduced preview that fits `budget_ms`, and its estimated seconds.
@@ -199,6 +224,48 @@ mod tests {
             shadows: true,
             bvh: false,
         }
+    }
+
+    #[test]
+    fn the_render_cache_gives_way_where_it_cannot_keep_up() {
+        if !reuses(&settings()) {
+            eprintln!("GLINT_PREVIEW=reduced: the render cache is off");
+            return;
+        }
+        let reuse_record = |seconds, width| PassRecord {
+            kind: ShownPass::drag_preview(Preview::Reuse),
+            seconds,
+            width,
+            reuse: Some(Default::default()),
+            ..base()
+        };
+        let choose =
+            |history: &[PassRecord]| choose_preview(history, &settings(), 33.0).map(|(p, _)| p);
+        // Untried, and after previews near their aim (25 ms of 33): the cache.
+        assert_eq!(choose(&[base()]), Some(Preview::Reuse));
+        let fast = [
+            base(),
+            reuse_record(0.03, 800),
+            reuse_record(0.028, 800),
+            reuse_record(0.2, 800),
+        ];
+        assert_eq!(choose(&fast), Some(Preview::Reuse), "the median is 30 ms");
+        // Three at four times their aim: a reduced preview instead.
+        let slow = [
+            base(),
+            reuse_record(0.1, 800),
+            reuse_record(0.11, 800),
+            reuse_record(0.09, 800),
+        ];
+        assert!(matches!(choose(&slow), Some(Preview::Reduced(_))));
+        // Slow at another size says nothing about this one.
+        let other = [
+            base(),
+            reuse_record(0.1, 1920),
+            reuse_record(0.11, 1920),
+            reuse_record(0.09, 1920),
+        ];
+        assert_eq!(choose(&other), Some(Preview::Reuse));
     }
 
     #[test]
