@@ -257,7 +257,7 @@ impl GlintApp {
 
     /// Writes the displayed frame to a PNG chosen in a save dialog, or,
     /// where no dialog is available, named in a path field filled in with
-    /// a timestamped name where exports go ([`export::choose_path`]).
+    /// a timestamped name where exports go (`export::choose_path`).
     pub fn export(&mut self) {
         let Some(path) = export::choose_path(&self.edit.source) else {
             return;
