@@ -39,27 +39,35 @@ pub fn choose_preview(
 
 /// How many times its aim the render cache's previews may take before the
 /// reduced previews are shown instead.
-const REUSE_OVERRUN: f64 = 2.0;
+const REUSE_OVERRUN: f64 = 2.5;
+
+/// Previews the rule of [`reuse_keeps_up`] looks at.
+const REUSE_JUDGED: usize = 5;
 
 /// Whether the render cache keeps up at this image size: the median of its
-/// last three previews of it within [`REUSE_OVERRUN`] times their aim (a
-/// large image on few cores can take several times the budget even at the
-/// cache's coarsest scale: its enlargement and upload alone are a frame's
-/// worth; the reduced previews then keep the motion fluid). Untried, it is
+/// last [`REUSE_JUDGED`] previews of it within [`REUSE_OVERRUN`] times their
+/// aim (a large image on few cores can take several times the budget even
+/// at the cache's coarsest scale: its enlargement and upload alone are a
+/// frame's worth; the reduced previews then keep the motion fluid).
+/// Previews that seeded the cache (the first of a drag, and after a change
+/// of scale) trace a ray for every point and are not judged. Untried, it is
 /// given the chance.
 fn reuse_keeps_up(history: &[PassRecord], settings: &RenderSettings, budget_ms: f64) -> bool {
     let mut recent: Vec<f64> = history
         .iter()
         .rev()
-        .filter(|r| r.reuse.is_some() && (r.width, r.height) == (settings.width, settings.height))
-        .take(3)
+        .filter(|r| {
+            r.reuse.is_some_and(|s| !s.seeded)
+                && (r.width, r.height) == (settings.width, settings.height)
+        })
+        .take(REUSE_JUDGED)
         .map(|r| r.seconds)
         .collect();
-    if recent.len() < 3 {
+    if recent.len() < REUSE_JUDGED {
         return true;
     }
     recent.sort_by(f64::total_cmp);
-    recent[1] <= REUSE_OVERRUN * reuse_seconds(budget_ms)
+    recent[REUSE_JUDGED / 2] <= REUSE_OVERRUN * reuse_seconds(budget_ms)
 }
 
 /// The reduced preview that fits `budget_ms`, and its estimated seconds.
@@ -239,32 +247,27 @@ mod tests {
             reuse: Some(Default::default()),
             ..base()
         };
+        let seeding = |seconds| PassRecord {
+            reuse: Some(crate::render::render_cache::PreviewSummary {
+                seeded: true,
+                ..Default::default()
+            }),
+            ..reuse_record(seconds, 800)
+        };
         let choose =
             |history: &[PassRecord]| choose_preview(history, &settings(), 33.0).map(|(p, _)| p);
         // Untried, and after previews near their aim (25 ms of 33): the cache.
         assert_eq!(choose(&[base()]), Some(Preview::Reuse));
-        let fast = [
-            base(),
-            reuse_record(0.03, 800),
-            reuse_record(0.028, 800),
-            reuse_record(0.2, 800),
-        ];
+        let fast = [0.03, 0.028, 0.2, 0.03, 0.05].map(|s| reuse_record(s, 800));
         assert_eq!(choose(&fast), Some(Preview::Reuse), "the median is 30 ms");
-        // Three at four times their aim: a reduced preview instead.
-        let slow = [
-            base(),
-            reuse_record(0.1, 800),
-            reuse_record(0.11, 800),
-            reuse_record(0.09, 800),
-        ];
+        // Five at four times their aim: a reduced preview instead.
+        let slow = [0.1, 0.11, 0.09, 0.1, 0.1].map(|s| reuse_record(s, 800));
         assert!(matches!(choose(&slow), Some(Preview::Reduced(_))));
+        // Previews that seeded the cache are slow by nature: not judged.
+        let seeded = [0.1, 0.11, 0.09, 0.1, 0.1].map(seeding);
+        assert_eq!(choose(&seeded), Some(Preview::Reuse));
         // Slow at another size says nothing about this one.
-        let other = [
-            base(),
-            reuse_record(0.1, 1920),
-            reuse_record(0.11, 1920),
-            reuse_record(0.09, 1920),
-        ];
+        let other = [0.1, 0.11, 0.09, 0.1, 0.1].map(|s| reuse_record(s, 1920));
         assert_eq!(choose(&other), Some(Preview::Reuse));
     }
 
