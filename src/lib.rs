@@ -21,6 +21,7 @@
 
 pub mod accel;
 pub mod camera;
+pub mod camera_path;
 pub mod color;
 pub mod export;
 pub mod image;

@@ -21,14 +21,14 @@ use std::path::Path;
 
 pub use error::ExportError;
 pub use output::{
-    OutputTarget, check_output, remove_unfinished_outputs, replaced_non_png, save_rgb_png,
-    write_file_atomically,
+    OutputTarget, check_output, remove_unfinished_outputs, replaced_non_png, save_animation,
+    save_rgb_png, write_file_atomically,
 };
 pub use png_file::{read_record, read_record_bytes};
 pub use record::{
     KEY_SCENE, KEY_SCENE_PATH, KEY_SCENE_SHA256, KEY_SETTINGS, KEY_VERSION, MAX_EMBEDDED_SCENE,
-    MAX_SCENE_TEXT, RecordedCamera, RecordedSettings, RenderRecord, SCENE_CHUNK, SceneEdits,
-    absolute_name, sha256_hex,
+    MAX_SCENE_TEXT, RecordedCamera, RecordedFrame, RecordedSettings, RenderRecord, SCENE_CHUNK,
+    SceneEdits, absolute_name, sha256_hex,
 };
 
 use crate::accel::Octree;
@@ -130,6 +130,8 @@ pub struct Restored {
     pub overlay_depth: Option<u32>,
     /// Whether the legend strip is drawn (diagnostic views, the overlay).
     pub legend: bool,
+    /// The frame of a sequence the PNG is, if it is one.
+    pub frame: Option<RecordedFrame>,
     /// Notes for the user: another glint version, a partial export.
     pub notes: Vec<String>,
 }
@@ -176,6 +178,7 @@ pub fn restore(png: &Path) -> Result<Restored, ExportError> {
         camera: record.settings.camera.into(),
         overlay_depth: record.settings.overlay_depth,
         legend: record.settings.legend,
+        frame: record.settings.frame,
         notes,
     })
 }

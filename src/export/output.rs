@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use super::error::ExportError;
-use super::png_file::write_png;
+use super::png_file::{Animation, write_animated_png, write_png};
 use super::record::RenderRecord;
 
 /// Where an output path's bytes go.
@@ -256,6 +256,48 @@ pub fn save_rgb_png(
     rgb: &[u8],
     record: Option<&RenderRecord>,
 ) -> Result<(), ExportError> {
+    write_output(path, &mut |out| {
+        write_png(out, path, width, height, rgb, record)
+    })
+}
+
+/// Writes an animated PNG (APNG) of `count` frames of `size` shown at
+/// `fps` frames a second, looping, as [`save_rgb_png`] writes a still one;
+/// `frames` yields each frame's RGB8 pixels in order. It carries `record`
+/// (the first frame's) for `glint info`.
+pub fn save_animation(
+    path: &Path,
+    size: (u32, u32),
+    count: u32,
+    fps: f64,
+    frames: &mut dyn Iterator<Item = Result<Vec<u8>, ExportError>>,
+    record: Option<&RenderRecord>,
+) -> Result<(), ExportError> {
+    let animation = Animation {
+        frames: count,
+        delay: frame_delay(fps),
+    };
+    write_output(path, &mut |out| {
+        write_animated_png(out, path, size, animation, frames, record)
+    })
+}
+
+/// An APNG frame's display time for `fps`: 1/fps seconds as a fraction
+/// with 16-bit parts (hundredths of a frame while they fit).
+fn frame_delay(fps: f64) -> (u16, u16) {
+    if fps * 100.0 <= f64::from(u16::MAX) {
+        (100, (fps * 100.0).round().max(1.0) as u16)
+    } else {
+        (1, fps.round().min(f64::from(u16::MAX)) as u16)
+    }
+}
+
+/// Runs `write` on where `path` leads: standard output for `-`, FIFOs and
+/// devices directly, files through a temporary file renamed into place.
+fn write_output(
+    path: &Path,
+    write: &mut dyn FnMut(&mut dyn std::io::Write) -> Result<(), ExportError>,
+) -> Result<(), ExportError> {
     let write_error = |source| ExportError::Write {
         path: path.to_owned(),
         source,
@@ -264,7 +306,7 @@ pub fn save_rgb_png(
         OutputTarget::Stdout => {
             use std::io::Write;
             let mut bytes = Vec::new();
-            write_png(&mut bytes, path, width, height, rgb, record)?;
+            write(&mut bytes)?;
             let mut out = std::io::stdout().lock();
             out.write_all(&bytes)
                 .and_then(|()| out.flush())
@@ -276,7 +318,7 @@ pub fn save_rgb_png(
                 .open(&p)
                 .map_err(write_error)?;
             let mut w = std::io::BufWriter::new(file);
-            write_png(&mut w, path, width, height, rgb, record)?;
+            write(&mut w)?;
             use std::io::Write;
             w.flush().map_err(write_error)
         }
@@ -289,7 +331,7 @@ pub fn save_rgb_png(
             let _unfinished = Unfinished::register(tmp.path());
             {
                 let mut w = std::io::BufWriter::new(tmp.as_file());
-                write_png(&mut w, path, width, height, rgb, record)?;
+                write(&mut w)?;
                 use std::io::Write;
                 w.flush().map_err(write_error)?;
             }

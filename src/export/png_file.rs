@@ -19,11 +19,60 @@ pub(super) fn write_png(
     rgb: &[u8],
     record: Option<&RenderRecord>,
 ) -> Result<(), ExportError> {
-    let encode = |e: png::EncodingError| ExportError::Encode {
+    let mut writer = start_png(out, path, (width, height), record, None)?;
+    writer.write_image_data(rgb).map_err(encode_error(path))?;
+    writer.finish().map_err(encode_error(path))
+}
+
+/// The frames of an animated PNG (APNG): how many, and each one's
+/// display time as a fraction of a second (numerator, denominator).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Animation {
+    pub frames: u32,
+    pub delay: (u16, u16),
+}
+
+/// Encodes an animated PNG into `out`: `frames` gives each frame's RGB8
+/// pixels in order (the first is also the still image viewers without
+/// APNG support show); it loops forever.
+pub(super) fn write_animated_png(
+    out: impl std::io::Write,
+    path: &Path,
+    size: (u32, u32),
+    animation: Animation,
+    frames: &mut dyn Iterator<Item = Result<Vec<u8>, ExportError>>,
+    record: Option<&RenderRecord>,
+) -> Result<(), ExportError> {
+    let mut writer = start_png(out, path, size, record, Some(animation))?;
+    for rgb in frames {
+        writer.write_image_data(&rgb?).map_err(encode_error(path))?;
+    }
+    writer.finish().map_err(encode_error(path))
+}
+
+fn encode_error(path: &Path) -> impl Fn(png::EncodingError) -> ExportError + '_ {
+    move |e| ExportError::Encode {
         path: path.to_owned(),
         message: e.to_string(),
-    };
+    }
+}
+
+/// The PNG's header and record chunks, up to its image data.
+fn start_png<W: std::io::Write>(
+    out: W,
+    path: &Path,
+    (width, height): (u32, u32),
+    record: Option<&RenderRecord>,
+    animation: Option<Animation>,
+) -> Result<png::Writer<W>, ExportError> {
+    let encode = encode_error(path);
     let mut encoder = png::Encoder::new(out, width, height);
+    if let Some(a) = animation {
+        encoder.set_animated(a.frames, 0).map_err(&encode)?;
+        encoder
+            .set_frame_delay(a.delay.0, a.delay.1)
+            .map_err(&encode)?;
+    }
     encoder.set_color(png::ColorType::Rgb);
     encoder.set_depth(png::BitDepth::Eight);
     // fdeflate: at the default level, writing a 256x192 render took more
@@ -35,8 +84,8 @@ pub(super) fn write_png(
             "Software".into(),
             format!("glint {}", env!("CARGO_PKG_VERSION")),
         )
-        .map_err(encode)?;
-    let mut writer = encoder.write_header().map_err(encode)?;
+        .map_err(&encode)?;
+    let mut writer = encoder.write_header().map_err(&encode)?;
     if let Some(r) = record {
         let settings = serde_json::to_string(&r.settings).map_err(|e| ExportError::Encode {
             path: path.to_owned(),
@@ -52,7 +101,7 @@ pub(super) fn write_png(
             // Settings with many edited materials can grow; compressed they
             // stay far below what readers accept.
             chunk.compressed = text.len() > 1024;
-            writer.write_text_chunk(&chunk).map_err(encode)?;
+            writer.write_text_chunk(&chunk).map_err(&encode)?;
         }
         if !r.settings.scene_not_embedded {
             let scene = compress(r.scene_text.as_bytes()).map_err(|e| ExportError::Encode {
@@ -61,11 +110,10 @@ pub(super) fn write_png(
             })?;
             writer
                 .write_chunk(png::chunk::ChunkType(SCENE_CHUNK), &scene)
-                .map_err(encode)?;
+                .map_err(&encode)?;
         }
     }
-    writer.write_image_data(rgb).map_err(encode)?;
-    writer.finish().map_err(encode)
+    Ok(writer)
 }
 
 /// Reads the record glint wrote into a PNG.

@@ -74,6 +74,22 @@ pub struct RecordedSettings {
     /// PNG: the record holds its path and SHA-256 only.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub scene_not_embedded: bool,
+    /// The image is one frame of a sequence (a turntable or a camera
+    /// path); `camera` is that frame's. Absent for single images.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frame: Option<RecordedFrame>,
+}
+
+/// Where a frame sits in its sequence.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RecordedFrame {
+    /// Its number, from 0.
+    pub index: u32,
+    /// Frames in the sequence.
+    pub count: u32,
+    /// Seconds along the scene's camera path (absent for a turntable).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time: Option<f64>,
 }
 
 /// A file a recorded scene read, as [`RecordedSettings::files`] lists it.
@@ -164,6 +180,7 @@ impl RenderRecord {
                     })
                     .collect(),
                 scene_not_embedded: scene.source_text.len() > MAX_EMBEDDED_SCENE,
+                frame: None,
             },
         }
     }

@@ -57,6 +57,8 @@ pub struct Scene {
     /// Where the scene came from, for messages and statistics.
     pub name: String,
     pub camera: CameraSpec,
+    /// The camera path a TOML scene's `[[camera.keyframes]]` give, if any.
+    pub camera_path: Option<crate::camera_path::CameraPath>,
     pub image: ImageSettings,
     pub octree_enabled: bool,
     pub octree_params: OctreeParams,
@@ -170,6 +172,7 @@ impl Scene {
         Self {
             name,
             camera,
+            camera_path: None,
             image,
             octree_enabled: true,
             octree_params: OctreeParams::default(),

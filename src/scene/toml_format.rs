@@ -12,6 +12,7 @@ use super::mesh::{Placement, parse_obj};
 use super::model::{ImageSettings, Location, Scene, SceneError, line_column};
 use crate::accel::OctreeParams;
 use crate::camera::CameraSpec;
+use crate::camera_path::{CameraPath, Keyframe, PathError};
 use crate::limits::{
     INTENSITY_RANGE, IOR_RANGE, MAX_IMAGE_SIDE, MAX_RAY_DEPTH, SHININESS_RANGE, UNIT_RANGE,
     check_color, check_finite, check_finite_vec3, check_integer, check_range,
@@ -46,6 +47,20 @@ struct CameraFile {
     lookat: Vec3,
     up: Vec3,
     fov: Spanned<f64>,
+    /// The camera path, in increasing time.
+    #[serde(default)]
+    keyframes: Vec<Spanned<KeyframeFile>>,
+}
+
+/// One key of the camera path: `up` and `fov` default to the camera's.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct KeyframeFile {
+    time: Spanned<f64>,
+    eye: Vec3,
+    lookat: Vec3,
+    up: Option<Vec3>,
+    fov: Option<Spanned<f64>>,
 }
 
 #[derive(Deserialize, Default)]
@@ -294,6 +309,7 @@ pub fn parse(text: &str, path: &Path, files: &dyn FileSource) -> Result<Scene, S
         };
         return Err(cx.error(span, &format!("camera.{key}"), message));
     }
+    let camera_path = camera_path(&cx, &file.camera.keyframes, &camera)?;
 
     let mut image = ImageSettings::default();
     let im = &file.image;
@@ -392,6 +408,7 @@ pub fn parse(text: &str, path: &Path, files: &dyn FileSource) -> Result<Scene, S
     }
 
     let mut scene = Scene::empty(path.display().to_string(), camera, image);
+    scene.camera_path = camera_path;
     scene.octree_enabled = file.octree.enabled.unwrap_or(true);
     if let Some(v) = file.octree.cost_driven {
         octree_params.cost_driven = v;
@@ -407,6 +424,61 @@ pub fn parse(text: &str, path: &Path, files: &dyn FileSource) -> Result<Scene, S
         scene.octree_params.leaf_size = OctreeParams::default_for(&scene.shapes).leaf_size;
     }
     Ok(scene)
+}
+
+/// The scene's camera path from its keyframes (none without any), each
+/// error pointing at the key at fault.
+fn camera_path(
+    cx: &Context,
+    keys: &[Spanned<KeyframeFile>],
+    camera: &CameraSpec,
+) -> Result<Option<CameraPath>, SceneError> {
+    if keys.is_empty() {
+        return Ok(None);
+    }
+    let mut keyframes = Vec::with_capacity(keys.len());
+    for (i, k) in keys.iter().enumerate() {
+        let key = |name: &str| format!("camera.keyframes[{i}].{name}");
+        let f = k.get_ref();
+        let spec = CameraSpec {
+            eye: cx.vec3(&f.eye, &key("eye"))?,
+            lookat: cx.vec3(&f.lookat, &key("lookat"))?,
+            up: match &f.up {
+                Some(up) => cx.vec3(up, &key("up"))?,
+                None => camera.up,
+            },
+            fov: match &f.fov {
+                Some(fov) => cx.finite(fov, &key("fov"))?,
+                None => camera.fov,
+            },
+        };
+        keyframes.push(Keyframe {
+            time: cx.finite(&f.time, &key("time"))?,
+            camera: spec,
+        });
+    }
+    CameraPath::new(keyframes)
+        .map_err(|e| {
+            let (index, name) = match &e {
+                PathError::TimeOrder { index, .. } | PathError::TimeNotFinite { index } => {
+                    (*index, "time")
+                }
+                PathError::Camera { index, .. } => (*index, "eye"),
+                _ => (0, "time"),
+            };
+            let f = keys[index].get_ref();
+            let span = if name == "time" {
+                f.time.span()
+            } else {
+                f.eye.span()
+            };
+            cx.error(
+                span,
+                &format!("camera.keyframes[{index}].{name}"),
+                e.to_string(),
+            )
+        })
+        .map(Some)
 }
 
 fn add_object(

@@ -19,6 +19,7 @@ mod render_scenes;
 mod robust_scenes;
 mod round_trip;
 mod self_intersection;
+mod sequences;
 mod simd_levels;
 mod source_files;
 mod spd_protocol;

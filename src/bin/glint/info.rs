@@ -142,6 +142,12 @@ fn write_info(
     writeln!(out, "camera lookat {}", v3(s.camera.lookat))?;
     writeln!(out, "camera up     {}", v3(s.camera.up))?;
     writeln!(out, "camera fov    {}", s.camera.fov)?;
+    if let Some(f) = &s.frame {
+        let time = f.time.map_or(" of a turntable".to_string(), |t| {
+            format!(", at {t} s along the camera path")
+        });
+        writeln!(out, "frame         {} of {}{time}", f.index, f.count)?;
+    }
     // The viewer records the lights and materials it rendered; they are
     // edits only where they differ from the recorded scene file's.
     let unedited = s.edits.as_ref().is_some_and(|e| {

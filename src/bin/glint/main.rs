@@ -34,6 +34,7 @@ mod bench;
 mod common;
 mod info;
 mod render_cmd;
+mod sequence;
 mod study;
 #[cfg(feature = "gui")]
 mod view;

@@ -102,6 +102,8 @@ pub struct RenderArgs {
     /// size.
     #[arg(long, value_enum)]
     pub legend: Option<crate::common::Switch>,
+    #[command(flatten)]
+    pub sequence: crate::sequence::SequenceArgs,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -110,12 +112,12 @@ pub enum OverlayKind {
 }
 
 /// A render ready to go: the scene, its octree and every setting, checked.
-struct Prepared {
-    scene: glint::scene::Scene,
-    scene_name: String,
-    settings: RenderSettings,
-    camera: CameraSpec,
-    octree: Octree,
+pub(crate) struct Prepared {
+    pub(crate) scene: glint::scene::Scene,
+    pub(crate) scene_name: String,
+    pub(crate) settings: RenderSettings,
+    pub(crate) camera: CameraSpec,
+    pub(crate) octree: Octree,
     /// Built with `--accel bvh`: then it answers every query.
     bvh: Option<glint::accel::Bvh>,
     /// Built when shadow rays go through an accelerator (it answers
@@ -123,10 +125,12 @@ struct Prepared {
     light_buffer: Option<(glint::accel::LightBuffer, f64)>,
     overlay_depth: Option<u32>,
     legend: bool,
+    /// The frame of a sequence a `--from-png` record says it renders.
+    frame: Option<glint::export::RecordedFrame>,
     threads: usize,
-    pool: rayon::ThreadPool,
-    load_s: f64,
-    build_s: f64,
+    pub(crate) pool: rayon::ThreadPool,
+    pub(crate) load_s: f64,
+    pub(crate) build_s: f64,
 }
 
 impl Prepared {
@@ -135,7 +139,16 @@ impl Prepared {
         &self,
         settings: RenderSettings,
     ) -> Result<Renderer<'_>, glint::render::RenderError> {
-        let renderer = Renderer::with_camera(&self.scene, &self.octree, settings, &self.camera)?
+        self.renderer_from(settings, &self.camera)
+    }
+
+    /// The renderer of this job with `settings` seen from `camera`.
+    pub(crate) fn renderer_from(
+        &self,
+        settings: RenderSettings,
+        camera: &CameraSpec,
+    ) -> Result<Renderer<'_>, glint::render::RenderError> {
+        let renderer = Renderer::with_camera(&self.scene, &self.octree, settings, camera)?
             .with_light_buffer(self.light_buffer.as_ref().map(|(b, _)| b));
         Ok(match &self.bvh {
             Some(bvh) => renderer.with_bvh(bvh),
@@ -145,7 +158,11 @@ impl Prepared {
 }
 
 pub fn run(args: &RenderArgs) -> Result<()> {
+    args.sequence.check(args)?;
     let job = prepare(args)?;
+    if args.sequence.is_sequence() {
+        return crate::sequence::run(args, &job);
+    }
     if let Some((x, y)) = args.trace_pixel {
         print_ray_tree(&job, x, y)?;
     }
@@ -168,8 +185,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 /// refusal comes before any rendering.
 fn prepare(args: &RenderArgs) -> Result<Prepared> {
     args.rules.check(args.max_depth, args.samples)?;
-    // Check the output before any work: its name, and that it is not an input.
-    if let Some(output) = &args.output {
+    // Check the output before any work: its name, and that it is not an
+    // input (a sequence's frames are checked by name once named).
+    if let Some(output) = args
+        .output
+        .as_ref()
+        .filter(|_| !args.sequence.is_sequence())
+    {
         let input = args.scene.as_deref().or(args.from_png.as_deref());
         let target = glint::export::check_output(output, input)?;
         if let Some(held) = glint::export::replaced_non_png(&target) {
@@ -199,6 +221,7 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
             .unwrap_or(glint::limits::DEFAULT_OVERLAY_DEPTH)
     });
     let mut legend = true;
+    let mut frame = None;
     let (mut scene, scene_name, mut settings, camera) = match (&args.from_png, &args.scene) {
         (Some(png), _) => {
             let restored = glint::export::restore(png)
@@ -211,6 +234,7 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
                 .map(|d| args.overlay_depth.unwrap_or(d))
                 .or(overlay_depth);
             legend = restored.legend;
+            frame = restored.frame;
             (
                 restored.scene,
                 restored.scene_path,
@@ -281,6 +305,7 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
         light_buffer,
         overlay_depth,
         legend,
+        frame,
         threads,
         pool,
         load_s,
@@ -358,10 +383,36 @@ fn save(
     frame: &glint::image::frame::Frame,
     output: &std::path::Path,
 ) -> Result<()> {
-    let s = &job.settings;
-    let mut record = glint::export::render_record(&job.scene, &job.scene_name, &job.camera, *s);
+    save_from(job, frame, output, &job.camera, job.frame)
+}
+
+/// The record a frame seen from `camera` carries (`sequence`: where it
+/// sits in its sequence), as [`save_from`] writes it.
+pub(crate) fn record_of(
+    job: &Prepared,
+    camera: &CameraSpec,
+    sequence: Option<glint::export::RecordedFrame>,
+) -> glint::export::RenderRecord {
+    let mut record =
+        glint::export::render_record(&job.scene, &job.scene_name, camera, job.settings);
     record.settings.legend = job.legend;
-    let camera = glint::camera::Camera::new(&job.camera, s.width, s.height)?;
+    record.settings.frame = sequence;
+    record.settings.overlay_depth = job.overlay_depth;
+    record
+}
+
+/// Writes `frame`, seen from `camera`, with its record (and the overlay,
+/// if asked for).
+pub(crate) fn save_from(
+    job: &Prepared,
+    frame: &glint::image::frame::Frame,
+    output: &std::path::Path,
+    camera_spec: &CameraSpec,
+    sequence: Option<glint::export::RecordedFrame>,
+) -> Result<()> {
+    let s = &job.settings;
+    let mut record = record_of(job, camera_spec, sequence);
+    let camera = glint::camera::Camera::new(camera_spec, s.width, s.height)?;
     let overlay = job
         .overlay_depth
         .map(|depth| glint::export::OverlayRequest {

@@ -224,3 +224,44 @@ fn the_leaf_size_follows_the_shapes_unless_the_file_sets_it() {
     let chosen = format!("{mesh}\n[octree]\nleaf_size = 4\n");
     assert_eq!(parse_str(&chosen).unwrap().octree_params.leaf_size, 4);
 }
+
+#[test]
+fn camera_keyframes_make_the_scene_path() {
+    let text = GOOD.replace(
+        "fov = 45\n",
+        "fov = 45\n\n[[camera.keyframes]]\ntime = 0\neye = [0, 0, 5]\nlookat = [0, 0, 0]\n\n\
+         [[camera.keyframes]]\ntime = 2.5\neye = [5, 0, 0]\nlookat = [0, 1, 0]\nfov = 30\n",
+    );
+    let s = parse_str(&text).unwrap();
+    let path = s.camera_path.expect("a path");
+    assert_eq!(path.keys().len(), 2);
+    assert_eq!(path.duration(), 2.5);
+    // up and fov default to the camera's.
+    assert_eq!(path.keys()[0].camera.up, DVec3::Y);
+    assert_eq!(path.keys()[0].camera.fov, 45.0);
+    assert_eq!(path.keys()[1].camera.fov, 30.0);
+    assert!(parse_str(GOOD).unwrap().camera_path.is_none());
+}
+
+#[test]
+fn bad_keyframes_name_their_line_and_key() {
+    let text = GOOD.replace(
+        "fov = 45\n",
+        "fov = 45\n\n[[camera.keyframes]]\ntime = 1\neye = [0, 0, 5]\nlookat = [0, 0, 0]\n\n\
+         [[camera.keyframes]]\ntime = 0.5\neye = [5, 0, 0]\nlookat = [0, 0, 0]\n",
+    );
+    let e = error_of(&text);
+    assert!(e.contains("test.toml:14:8"), "{e}");
+    assert!(e.contains("camera.keyframes[1].time"), "{e}");
+    assert!(e.contains("increasing time"), "{e}");
+    let e = error_of(&GOOD.replace(
+        "fov = 45\n",
+        "fov = 45\n[[camera.keyframes]]\ntime = 0\neye = [0, 0, 0]\nlookat = [0, 0, 0]\n",
+    ));
+    assert!(e.contains("camera.keyframes[0].eye"), "{e}");
+    let e = error_of(&GOOD.replace(
+        "fov = 45\n",
+        "fov = 45\n[[camera.keyframes]]\ntime = 0\neye = [0, 0, 1]\nlookat = [0, 0, 0]\nspeed = 2\n",
+    ));
+    assert!(e.contains("speed"), "{e}");
+}
