@@ -20,6 +20,10 @@ import os as _os
 from . import _glint
 from ._glint import Cancelled, SceneError, __version__
 from ._frame import Frame
+from ._sequences import Viewpoint, frame_file, render_frames, sweep
+from ._sequences import as_viewpoint as _as_viewpoint
+from ._sequences import camera_path as _camera_path
+from ._sequences import turntable as _turntable
 from ._views import Camera, Light, Lights, Material, Materials, OctreeParams
 
 __all__ = [
@@ -33,8 +37,12 @@ __all__ = [
     "OctreeParams",
     "Scene",
     "SceneError",
+    "Viewpoint",
     "default_scene",
+    "frame_file",
     "load",
+    "render_frames",
+    "sweep",
 ]
 
 
@@ -86,8 +94,29 @@ class Scene:
 
     @property
     def camera(self):
-        """The camera: ``eye``, ``lookat``, ``up``, ``fov`` (degrees)."""
+        """The camera: ``eye``, ``lookat``, ``up``, ``fov`` (degrees).
+        Assigning a :class:`Viewpoint` (or a mapping of those keys) sets
+        all four at once."""
         return Camera(self._native)
+
+    @camera.setter
+    def camera(self, value):
+        self._native.set_camera(_as_viewpoint(value)._native())
+
+    def turntable(self, n):
+        """``n`` cameras (:class:`Viewpoint`) evenly around a full turn:
+        the eye turns about the axis through lookat along the camera's up,
+        at its distance and height; the first is the scene's camera.
+        ``glint render --turntable N`` renders the same cameras."""
+        return _turntable(self, n)
+
+    def camera_path(self, fps=None, seconds=None, frames=None):
+        """The cameras (:class:`Viewpoint`, with their ``time``) of the
+        scene's camera path, ``[[camera.keyframes]]``, as ``glint render
+        --path`` renders them: frame k at ``k / fps`` seconds (24 fps
+        unless given) to the last key or ``seconds``, or ``frames`` spread
+        over it. A ``ValueError`` when the scene has no path."""
+        return _camera_path(self, fps, seconds, frames)
 
     @property
     def lights(self):
@@ -139,6 +168,8 @@ class Scene:
         colors=None,
         sides=None,
         cancel=None,
+        camera=None,
+        frame=None,
     ):
         """Renders a :class:`Frame`. Unset arguments keep the scene's
         settings, as ``glint render``'s flags do: ``samples`` 1 or 16 or
@@ -148,7 +179,10 @@ class Scene:
         counts the work per ray, as ``--stats`` does (the same image, in
         more time) and fills ``frame.stats``. ``cancel``, an object with
         ``is_set()`` such as ``threading.Event``, stops the render with
-        :class:`Cancelled`; Ctrl+C stops it with ``KeyboardInterrupt``."""
+        :class:`Cancelled`; Ctrl+C stops it with ``KeyboardInterrupt``.
+        ``camera`` (a :class:`Viewpoint` or mapping) renders from there
+        instead of the scene's camera; ``frame``, ``(index, count, time)``,
+        records the image as that frame of a sequence in its PNG."""
         native = self._native.render(
             width,
             height,
@@ -163,6 +197,8 @@ class Scene:
             colors=colors,
             sides=sides,
             cancel=cancel,
+            camera=None if camera is None else _as_viewpoint(camera)._native(),
+            frame=frame,
         )
         return Frame(native)
 

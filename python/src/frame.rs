@@ -8,7 +8,7 @@ use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyByteArray, PyBytes};
 
-use glint::export::SceneEdits;
+use glint::export::{RecordedFrame, SceneEdits};
 use glint::image::frame::Frame;
 use glint::scene::Scene;
 use glint::settings::RenderSettings;
@@ -25,6 +25,18 @@ pub struct PyFrame {
     scene_name: String,
     edits: Option<SceneEdits>,
     stats: Option<String>,
+    /// Where the frame sits in a sequence, for its record.
+    sequence: Option<RecordedFrame>,
+}
+
+/// What a frame's pixels need besides the numbers to be a frame again in
+/// another process ([`PyFrame::parts`]).
+#[derive(serde::Serialize, serde::Deserialize)]
+pub struct FrameHeader {
+    pub width: u32,
+    pub height: u32,
+    pub view: glint::settings::ViewMode,
+    pub colors: glint::color::ColorConvention,
 }
 
 impl PyFrame {
@@ -43,7 +55,36 @@ impl PyFrame {
             scene_name,
             edits,
             stats,
+            sequence: None,
         }
+    }
+
+    /// The same frame, recorded as frame `sequence` of a sequence.
+    pub fn in_sequence(mut self, sequence: Option<RecordedFrame>) -> Self {
+        self.sequence = sequence;
+        self
+    }
+
+    /// A frame from [`PyFrame::parts`]' header and pixels.
+    pub fn from_parts(header: &FrameHeader, pixels: &[u8]) -> Option<Frame> {
+        let count = header.width as usize * header.height as usize;
+        if pixels.len() != count * 24 {
+            return None;
+        }
+        let values: Vec<f64> = pixels
+            .chunks_exact(8)
+            .map(|b| f64::from_le_bytes(b.try_into().unwrap_or_default()))
+            .collect();
+        Some(Frame {
+            width: header.width,
+            height: header.height,
+            view: header.view,
+            colors: header.colors,
+            pixels: values
+                .chunks_exact(3)
+                .map(|c| glint::math::DVec3::new(c[0], c[1], c[2]))
+                .collect(),
+        })
     }
 
     /// The image's 8-bit RGB rows and their count: with the legend strip
@@ -79,6 +120,26 @@ impl PyFrame {
     #[getter]
     fn stats_json(&self) -> Option<&str> {
         self.stats.as_deref()
+    }
+
+    /// The frame exactly, for another process (a Dask worker's result):
+    /// a JSON header and the values as little-endian 64-bit floats.
+    fn parts<'py>(&self, py: Python<'py>) -> PyResult<(String, Bound<'py, PyBytes>)> {
+        let header = FrameHeader {
+            width: self.frame.width,
+            height: self.frame.height,
+            view: self.frame.view,
+            colors: self.frame.colors,
+        };
+        let header = serde_json::to_string(&header)
+            .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
+        let mut bytes = Vec::with_capacity(self.frame.pixels.len() * 24);
+        for p in &self.frame.pixels {
+            for c in p.to_array() {
+                bytes.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        Ok((header, PyBytes::new(py, &bytes)))
     }
 
     /// The frame's values, row-major from the top, three per pixel, as
@@ -128,6 +189,7 @@ impl PyFrame {
                 glint::export::render_record(&self.scene, &self.scene_name, &camera, self.settings);
             record.settings.legend = legend;
             record.settings.edits = self.edits.clone();
+            record.settings.frame = self.sequence;
             glint::export::save_frame(&self.frame, &path, &mut record, None)
         })
         .map_err(|e| match e {

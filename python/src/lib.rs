@@ -48,6 +48,23 @@ fn from_toml(py: Python<'_>, text: &str, path: PathBuf) -> PyResult<PyScene> {
     Ok(PyScene::new(scene, path.display().to_string(), load_s))
 }
 
+/// A scene from `Scene.source()`'s name and text, as another process
+/// loaded it (a Dask worker's copy): the built-in scene by its name,
+/// others parsed as the file `name` (which anchors relative mesh paths).
+#[pyfunction]
+fn from_source(py: Python<'_>, name: String, text: &str) -> PyResult<PyScene> {
+    let start = Instant::now();
+    let scene = py.detach(|| {
+        if name == glint::scene::builtin::NAME {
+            glint::scene::builtin::load_text(text)
+        } else {
+            glint::scene::load_str(text, std::path::Path::new(&name), &glint::scene::FileSystem)
+        }
+    });
+    let scene = scene.map_err(|e| load_error(py, &e))?;
+    Ok(PyScene::new(scene, name, start.elapsed().as_secs_f64()))
+}
+
 /// The scene glint opens with no file: the default scene built into it.
 #[pyfunction]
 fn default_scene(py: Python<'_>) -> PyResult<PyScene> {
@@ -67,6 +84,7 @@ fn _glint(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(from_toml, m)?)?;
     m.add_function(wrap_pyfunction!(default_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(from_source, m)?)?;
     m.add_class::<PyScene>()?;
     m.add_class::<PyFrame>()?;
     m.add("SceneError", py.get_type::<SceneError>())?;

@@ -17,7 +17,43 @@ use glint::report::{RenderStats, RenderTimes, TraceReport};
 use glint::scene::{KeyValue, Scene};
 
 use crate::errors::{edit_error, octree_error, render_error};
-use crate::frame::PyFrame;
+use crate::frame::{FrameHeader, PyFrame};
+
+/// A camera as Python passes it: eye, lookat, up, fov (degrees).
+type CameraTuple = ([f64; 3], [f64; 3], [f64; 3], f64);
+/// A frame's place in a sequence: index, count, time along the path.
+type FrameTuple = (u32, u32, Option<f64>);
+
+fn camera_spec((eye, lookat, up, fov): CameraTuple) -> PyResult<glint::camera::CameraSpec> {
+    use glint::math::DVec3;
+    let spec = glint::camera::CameraSpec {
+        eye: DVec3::from_array(eye),
+        lookat: DVec3::from_array(lookat),
+        up: DVec3::from_array(up),
+        fov,
+    };
+    spec.check()
+        .map_err(|(key, message)| PyValueError::new_err(format!("camera {key}: {message}")))?;
+    Ok(spec)
+}
+
+fn camera_tuple(c: &glint::camera::CameraSpec) -> CameraTuple {
+    (
+        c.eye.to_array(),
+        c.lookat.to_array(),
+        c.up.to_array(),
+        c.fov,
+    )
+}
+
+fn recorded_frame((index, count, time): FrameTuple) -> PyResult<glint::export::RecordedFrame> {
+    if index >= count {
+        return Err(PyValueError::new_err(format!(
+            "frame {index} of {count}: a frame's index is below the sequence's count"
+        )));
+    }
+    Ok(glint::export::RecordedFrame { index, count, time })
+}
 use crate::interrupt::run_stoppable;
 use crate::options::{RenderOptions, count, thread_pool};
 
@@ -240,7 +276,7 @@ impl PyScene {
 
     #[pyo3(signature = (width=None, height=None, samples=None, aa=None, octree=None,
         max_depth=None, view=None, threads=None, stats=false, protocol=None, colors=None,
-        sides=None, cancel=None))]
+        sides=None, cancel=None, camera=None, frame=None))]
     #[allow(clippy::too_many_arguments)]
     fn render(
         slf: &Bound<'_, Self>,
@@ -257,9 +293,15 @@ impl PyScene {
         colors: Option<&str>,
         sides: Option<&str>,
         cancel: Option<&Bound<'_, PyAny>>,
+        camera: Option<CameraTuple>,
+        frame: Option<FrameTuple>,
     ) -> PyResult<PyFrame> {
         let py = slf.py();
-        let snap = snapshot(slf);
+        let mut snap = snapshot(slf);
+        if let Some(c) = camera {
+            snap.scene.camera = camera_spec(c)?;
+        }
+        let sequence = frame.map(recorded_frame).transpose()?;
         let options = RenderOptions {
             width: count("width", width)?,
             height: count("height", height)?,
@@ -326,7 +368,118 @@ impl PyScene {
             snap.name,
             snap.edits,
             stats_json,
-        ))
+        )
+        .in_sequence(sequence))
+    }
+
+    /// A frame this scene rendered elsewhere (a Dask worker's), from
+    /// `Frame.parts()`, with the settings, camera and sequence place it was
+    /// rendered with, so its PNG and record are the ones a local render
+    /// writes.
+    #[pyo3(signature = (header, pixels, width=None, height=None, samples=None, aa=None,
+        octree=None, max_depth=None, view=None, protocol=None, colors=None, sides=None,
+        camera=None, frame=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn frame_from_parts(
+        slf: &Bound<'_, Self>,
+        header: &str,
+        pixels: &[u8],
+        width: Option<i64>,
+        height: Option<i64>,
+        samples: Option<i64>,
+        aa: Option<&str>,
+        octree: Option<bool>,
+        max_depth: Option<i64>,
+        view: Option<&str>,
+        protocol: Option<&str>,
+        colors: Option<&str>,
+        sides: Option<&str>,
+        camera: Option<CameraTuple>,
+        frame: Option<FrameTuple>,
+    ) -> PyResult<PyFrame> {
+        let mut snap = snapshot(slf);
+        if let Some(c) = camera {
+            snap.scene.camera = camera_spec(c)?;
+        }
+        let options = RenderOptions {
+            width: count("width", width)?,
+            height: count("height", height)?,
+            samples: count("samples", samples)?,
+            aa,
+            octree,
+            max_depth: count("max_depth", max_depth)?,
+            view,
+            protocol,
+            colors,
+            sides,
+        };
+        let settings = options.settings(&snap.scene)?;
+        let header: FrameHeader = serde_json::from_str(header)
+            .map_err(|e| PyValueError::new_err(format!("not a frame's header: {e}")))?;
+        let rendered = PyFrame::from_parts(&header, pixels)
+            .filter(|f| {
+                (f.width, f.height, f.view) == (settings.width, settings.height, settings.view)
+            })
+            .ok_or_else(|| PyValueError::new_err("the pixels are not a frame of these settings"))?;
+        Ok(
+            PyFrame::new(rendered, settings, snap.scene, snap.name, snap.edits, None)
+                .in_sequence(frame.map(recorded_frame).transpose()?),
+        )
+    }
+
+    /// Sets the camera at once (eye, lookat, up, fov), checked as a scene
+    /// file's is.
+    fn set_camera(&mut self, camera: CameraTuple) -> PyResult<()> {
+        self.scene.camera = camera_spec(camera)?;
+        Ok(())
+    }
+
+    /// `frames` cameras of a turntable about the lookat point (the
+    /// camera's up is the axis), frame 0 the scene's camera.
+    fn turntable(&self, frames: i64) -> PyResult<Vec<CameraTuple>> {
+        let n = count("n", Some(frames))?.unwrap_or(0);
+        if !(1..=glint::camera_path::MAX_FRAMES).contains(&n) {
+            return Err(PyValueError::new_err(format!(
+                "a turntable has from 1 to 1,000,000 frames, got {frames}"
+            )));
+        }
+        Ok(glint::camera_path::turntable(&self.scene.camera, n)
+            .iter()
+            .map(camera_tuple)
+            .collect())
+    }
+
+    /// The scene's camera path at `fps` for `seconds` (or `frames`), as
+    /// `glint render --path` renders it: (time, camera) pairs.
+    #[pyo3(signature = (fps=None, seconds=None, frames=None))]
+    fn camera_path(
+        &self,
+        fps: Option<f64>,
+        seconds: Option<f64>,
+        frames: Option<i64>,
+    ) -> PyResult<Vec<(f64, CameraTuple)>> {
+        let Some(path) = &self.scene.camera_path else {
+            return Err(PyValueError::new_err(format!(
+                "{} has no camera path: give it [[camera.keyframes]] (time, eye, lookat), \
+                 or use turntable(n)",
+                self.name
+            )));
+        };
+        let timing = glint::camera_path::FrameTiming {
+            fps,
+            seconds,
+            frames: count("frames", frames)?,
+        };
+        let frames = path
+            .frames(&timing)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        Ok(frames.iter().map(|(t, c)| (*t, camera_tuple(c))).collect())
+    }
+
+    /// The scene's name and the text it was parsed from, to load it again
+    /// in another process (`glint._glint.from_source`).
+    fn source(&self) -> (String, String) {
+        (self.name.clone(), self.scene.source_text.to_string())
     }
 
     /// The `--trace-pixel` JSON of pixel (x, y) of the image these
