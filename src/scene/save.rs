@@ -57,6 +57,9 @@ pub struct SaveRequest<'a> {
     pub loaded_path: &'a Path,
     /// The camera to save.
     pub camera: &'a CameraSpec,
+    /// The camera path to save (TOML's `[[camera.keyframes]]`; none
+    /// removes them).
+    pub camera_path: Option<&'a crate::camera_path::CameraPath>,
     /// Lights as edited (as many as the scene has).
     pub lights: &'a [Light],
     /// Materials as edited (the scene's, in its order).
@@ -106,6 +109,8 @@ pub enum LeftOut {
     Material {
         name: String,
     },
+    /// The camera path's keyframes (NFF has no camera path).
+    CameraPath,
 }
 
 impl std::fmt::Display for LeftOut {
@@ -125,6 +130,7 @@ impl std::fmt::Display for LeftOut {
                 "{material} apart from {equal_to} (equal materials are one in NFF)"
             ),
             LeftOut::Material { name } => write!(f, "material {name}"),
+            LeftOut::CameraPath => f.write_str("the camera path (save as TOML to keep it)"),
         }
     }
 }

@@ -8,6 +8,7 @@ use std::sync::Arc;
 
 use egui::{Color32, Sense, TextureHandle, TextureOptions};
 
+mod camera_path;
 mod octree_tuning;
 mod options;
 mod scene_files;
@@ -27,7 +28,7 @@ use super::screenshot::Screenshot;
 pub use super::state::{CompareSetting, SceneSource};
 use super::state::{EditState, Magnification, Snapshot};
 use super::worker::{Job, Preview, Worker};
-use super::{budget, export, input, panels, timing};
+use super::{budget, export, input, panels, path_panel, timing};
 use crate::accel::{Octree, OctreeParams};
 use crate::camera::CameraSpec;
 use crate::render::UnitCosts;
@@ -116,6 +117,8 @@ pub struct GlintApp {
     /// Pointer events so far: each job carries the count it reflects.
     input_serial: u64,
     orbit_bench: Option<OrbitBench>,
+    /// Recording or playing the camera path.
+    path_player: path_panel::PathPlayer,
 }
 
 impl GlintApp {
@@ -134,6 +137,7 @@ impl GlintApp {
         let (octree, build_seconds) = build_octree(&scene)?;
         let mut edit = EditState {
             camera: scene.camera,
+            camera_path: scene.camera_path.clone(),
             source,
             loaded: Arc::new(scene.clone()),
             scene: Arc::new(scene),
@@ -180,6 +184,7 @@ impl GlintApp {
             image_rect: None,
             input_serial: 0,
             orbit_bench: options.orbit_bench.map(OrbitBench::new),
+            path_player: Default::default(),
         };
         if let Some((i, j)) = options.inspect {
             app.inspect_pixel(i, j);
@@ -400,11 +405,12 @@ impl GlintApp {
                         .as_ref()
                         .is_some_and(|job| Arc::ptr_eq(&job.octree, &self.octree)),
                 };
+                let path = (&self.path_player, ui.input(|i| i.time));
                 commands.extend(panels::controls_ui(
                     &mut self.edit,
                     &mut self.inspect,
                     &self.worker,
-                    &octree,
+                    (&octree, path),
                     ui,
                 ))
             });
@@ -418,6 +424,7 @@ impl GlintApp {
         self.discard_prompt_ui(&ctx);
         self.path_prompt_ui(&ctx);
         self.apply(commands, &ctx);
+        self.path_logic(&ctx);
         self.sync_octree();
         self.octree_tuning_logic(&ctx);
         self.undoer
@@ -568,6 +575,7 @@ impl GlintApp {
                 Command::SetOctreeParams(params) => self.set_octree_params(params),
                 Command::SuggestOctree => self.suggest_octree(),
                 Command::SampleRays => self.sample_rays(),
+                Command::CameraPath(c) => self.path_command(c, ctx),
                 Command::Quit => ctx.send_viewport_cmd(egui::ViewportCommand::Close),
             }
         }

@@ -35,5 +35,22 @@ pub enum Command {
     /// Sample the view's rays through the current tree in the background
     /// (asked for by the octree panel while it is open).
     SampleRays,
+    /// Record, play or edit the camera path.
+    CameraPath(PathCommand),
     Quit,
+}
+
+/// What the camera path panel and its shortcuts ask for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PathCommand {
+    /// Start recording camera moves as keyframes, or stop.
+    ToggleRecording,
+    /// Play the path back, or stop.
+    TogglePlaying,
+    /// Add the camera as it is as a keyframe after the last.
+    AddKeyframe,
+    /// Delete keyframe `n`.
+    Delete(usize),
+    /// Delete the whole path.
+    Clear,
 }

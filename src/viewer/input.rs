@@ -61,6 +61,7 @@ pub fn shortcuts(ctx: &egui::Context) -> Vec<Command> {
     if !typing && ctx.input(|i| i.key_pressed(Key::R) && i.modifiers.is_none()) {
         commands.push(Command::ResetCamera);
     }
+    commands.extend(super::path_panel::shortcuts(ctx, typing));
     commands
 }
 

@@ -16,6 +16,7 @@ mod orbit;
 pub mod orbit_bench;
 mod panels;
 mod pass_cache;
+mod path_panel;
 pub mod pixel;
 mod preview;
 mod save;

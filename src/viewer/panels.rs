@@ -129,7 +129,10 @@ pub fn controls_ui(
     edit: &mut EditState,
     inspect: &mut InspectState,
     worker: &Worker,
-    octree: &super::octree_panel::OctreeInfo,
+    (octree, (player, now)): (
+        &super::octree_panel::OctreeInfo,
+        (&super::path_panel::PathPlayer, f64),
+    ),
     ui: &mut egui::Ui,
 ) -> Vec<Command> {
     let mut commands = Vec::new();
@@ -159,6 +162,11 @@ pub fn controls_ui(
         egui::CollapsingHeader::new("Camera")
             .default_open(true)
             .show(ui, |ui| commands.extend(camera_ui(edit, speed, ui)));
+        egui::CollapsingHeader::new("Camera path")
+            .default_open(true)
+            .show(ui, |ui| {
+                commands.extend(super::path_panel::path_ui(edit, player, now, ui))
+            });
         egui::CollapsingHeader::new("Lights")
             .default_open(true)
             .show(ui, |ui| lights_ui(edit, speed, ui));

@@ -113,6 +113,7 @@ pub fn save(edit: &EditState, baseline: &Snapshot, destination: &Path) -> anyhow
         loaded: &edit.loaded,
         loaded_path: &loaded_path,
         camera: &edit.camera,
+        camera_path: edit.camera_path.as_ref(),
         lights: &edit.scene.lights,
         materials: &edit.scene.materials,
         settings: &settings,

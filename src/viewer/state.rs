@@ -7,6 +7,7 @@ use std::sync::Arc;
 
 use crate::accel::OctreeParams;
 use crate::camera::CameraSpec;
+use crate::camera_path::CameraPath;
 use crate::material::{Light, Material};
 use crate::scene::Scene;
 use crate::settings::{Accel, RenderSettings};
@@ -123,6 +124,9 @@ pub struct EditState {
     /// Bumped whenever the scene changes, so the app can tell.
     pub scene_version: u64,
     pub camera: CameraSpec,
+    /// The scene's camera path as edited (keyframes added, recorded,
+    /// deleted); saved into the scene file's `[[camera.keyframes]]`.
+    pub camera_path: Option<CameraPath>,
     /// What to render; with anti-aliasing, the 16-sample pass follows the
     /// 1-sample one.
     pub settings: RenderSettings,
@@ -138,6 +142,7 @@ pub struct EditState {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Snapshot {
     pub camera: CameraSpec,
+    pub camera_path: Option<CameraPath>,
     pub settings: RenderSettings,
     pub lights: Vec<Light>,
     pub materials: Vec<Material>,
@@ -166,6 +171,7 @@ impl Snapshot {
             )
         };
         self.camera != other.camera
+            || self.camera_path != other.camera_path
             || self.lights != other.lights
             || self.materials != other.materials
             || self.octree != other.octree
@@ -188,6 +194,7 @@ impl EditState {
     pub fn snapshot(&self) -> Snapshot {
         Snapshot {
             camera: self.camera,
+            camera_path: self.camera_path.clone(),
             settings: self.settings,
             lights: self.scene.lights.clone(),
             materials: self.scene.materials.clone(),
@@ -198,6 +205,7 @@ impl EditState {
     /// Puts back an earlier [`Snapshot`] (undo, redo).
     pub fn restore(&mut self, s: &Snapshot) {
         self.camera = s.camera;
+        self.camera_path.clone_from(&s.camera_path);
         self.settings = s.settings;
         if self.scene.lights != s.lights || self.scene.materials != s.materials {
             let scene = self.scene_mut();

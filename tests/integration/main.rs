@@ -26,5 +26,6 @@ mod spd_protocol;
 mod viewer;
 mod viewer_files;
 mod viewer_panels;
+mod viewer_path;
 mod viewer_worker;
 mod walk;

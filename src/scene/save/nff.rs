@@ -89,6 +89,9 @@ pub fn scene_nff(request: &SaveRequest) -> Result<SavedText, SaveError> {
     if *request.octree != loaded.octree_params {
         left_out.push(LeftOut::OctreeParams);
     }
+    if request.camera_path != loaded.camera_path.as_ref() {
+        left_out.push(LeftOut::CameraPath);
+    }
 
     for ((place, old), new) in layout.lights.iter().zip(&loaded.lights).zip(request.lights) {
         put(

@@ -33,6 +33,7 @@ fn request<'a>(
         loaded,
         loaded_path: Path::new("dir/scene.toml"),
         camera,
+        camera_path: loaded.camera_path.as_ref(),
         lights: &loaded.lights,
         materials: &loaded.materials,
         settings,
@@ -261,6 +262,7 @@ fn nff_request<'a>(
         loaded,
         loaded_path: Path::new("dir/balls.nff"),
         camera,
+        camera_path: loaded.camera_path.as_ref(),
         lights,
         materials,
         settings,
@@ -496,4 +498,46 @@ fn nff_saves_rewrite_only_edited_numbers_in_the_files_style() {
     assert!(!saved.text.contains("angle 45"), "{}", saved.text);
     let again = load_str(&saved.text, path, &NoMeshes).unwrap();
     assert!((again.camera.fov - 30.0).abs() < 1e-12);
+}
+
+#[test]
+fn a_camera_path_is_written_as_keyframes_and_reads_back_the_same() {
+    use crate::camera_path::{CameraPath, Keyframe};
+    let path = Path::new("dir/scene.toml");
+    let loaded = scene(TEXT);
+    let settings = loaded.render_settings();
+    let key = |time: f64, x: f64| Keyframe {
+        time,
+        camera: CameraSpec {
+            eye: DVec3::new(x, 1.0 / 3.0, 5.0),
+            ..loaded.camera
+        },
+    };
+    let edited = CameraPath::new(vec![key(0.0, 0.1), key(1.25, 2.0 / 7.0)]).unwrap();
+    let req = SaveRequest {
+        camera_path: Some(&edited),
+        ..request(&loaded, &loaded.camera, &settings)
+    };
+    let saved = scene_toml(&req, path).unwrap();
+    let again = load_str(&saved.text, path, &NoMeshes).unwrap();
+    assert_eq!(again.camera_path.as_ref(), Some(&edited), "{}", saved.text);
+    // Removing it removes the keyframes.
+    let req = SaveRequest {
+        loaded: &again,
+        camera_path: None,
+        ..request(&again, &again.camera, &settings)
+    };
+    let text = scene_toml(&req, path).unwrap().text;
+    assert!(!text.contains("keyframes"), "{text}");
+    // NFF has no place for one: it is said, not lost silently.
+    let nff = load_str(NFF, Path::new("dir/balls.nff"), &NoMeshes).unwrap();
+    let lights = nff.lights.clone();
+    let materials = nff.materials.clone();
+    let nff_settings = nff.render_settings();
+    let saved = scene_nff(&SaveRequest {
+        camera_path: Some(&edited),
+        ..nff_request(&nff, &nff.camera, &nff_settings, &lights, &materials)
+    })
+    .unwrap();
+    assert!(saved.left_out.contains(&LeftOut::CameraPath));
 }

@@ -8,6 +8,7 @@ use super::mesh_paths::write_mesh_paths;
 use super::{LeftOut, SaveError, SaveRequest, SavedText, set, tables_of};
 use crate::accel::OctreeParams;
 use crate::camera::CameraSpec;
+use crate::camera_path::CameraPath;
 use crate::material::{Light, Material};
 use crate::math::DVec3;
 use crate::scene::{MeshMaterialOrigin, Scene};
@@ -34,6 +35,7 @@ pub fn scene_toml(request: &SaveRequest, destination: &Path) -> Result<SavedText
         })?;
 
     write_camera(&mut doc, &loaded.camera, request.camera);
+    write_camera_path(&mut doc, loaded.camera_path.as_ref(), request.camera_path);
     write_settings(&mut doc, loaded, request.settings);
     write_octree(&mut doc, &loaded.octree_params, request.octree);
     if request.lights.len() != loaded.lights.len() {
@@ -89,6 +91,36 @@ fn write_camera(doc: &mut DocumentMut, loaded: &CameraSpec, camera: &CameraSpec)
     if loaded.fov != camera.fov {
         set(t, "fov", Value::from(camera.fov));
     }
+}
+
+/// The camera path as `[[camera.keyframes]]`, written whole when it
+/// differs from the file's (each key with its time, eye, lookat, up, fov).
+fn write_camera_path(
+    doc: &mut DocumentMut,
+    loaded: Option<&CameraPath>,
+    path: Option<&CameraPath>,
+) {
+    if loaded == path {
+        return;
+    }
+    let Some(t) = table(doc, "camera") else {
+        return;
+    };
+    let Some(path) = path else {
+        t.remove("keyframes");
+        return;
+    };
+    let mut keys = toml_edit::ArrayOfTables::new();
+    for k in path.keys() {
+        let mut key = toml_edit::Table::new();
+        key.insert("time", toml_edit::value(k.time));
+        key.insert("eye", Item::Value(vec3(k.camera.eye)));
+        key.insert("lookat", Item::Value(vec3(k.camera.lookat)));
+        key.insert("up", Item::Value(vec3(k.camera.up)));
+        key.insert("fov", toml_edit::value(k.camera.fov));
+        keys.push(key);
+    }
+    t.insert("keyframes", Item::ArrayOfTables(keys));
 }
 
 /// The `[octree]` keys whose values were edited.

@@ -132,6 +132,9 @@ impl GlintApp {
                         LeftOut::Sides => b.sides = file.sides,
                         LeftOut::OctreeSwitch => b.use_octree = file.use_octree,
                         LeftOut::OctreeParams => baseline.octree = reloaded.octree_params,
+                        LeftOut::CameraPath => {
+                            baseline.camera_path.clone_from(&reloaded.camera_path)
+                        }
                         // Material edits left out are told, not undone: the
                         // materials came back from the file above.
                         LeftOut::Reflectivity { .. }
@@ -220,6 +223,7 @@ impl GlintApp {
             }
             .with_protocol(edit.settings.protocol);
         }
+        edit.camera_path.clone_from(&scene.camera_path);
         edit.loaded = Arc::new(scene.clone());
         edit.scene = Arc::new(scene);
         edit.scene_version += 1;
