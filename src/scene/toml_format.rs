@@ -259,6 +259,42 @@ pub fn parse(text: &str, path: &Path, files: &dyn FileSource) -> Result<Scene, S
         path,
         defined_materials: 0,
     };
+    let file: SceneFile = deserialize(&cx)?;
+    parse_file(&mut cx, &file, path, files)
+}
+
+/// A camera path on its own: a TOML file of `[[keyframes]]` (time, eye,
+/// lookat, and up and fov defaulting to `camera`'s), for scenes whose
+/// format has no place for one (NFF, OBJ). Errors name `path`, the line,
+/// the column and the key.
+pub fn parse_camera_path(
+    text: &str,
+    path: &Path,
+    camera: &CameraSpec,
+) -> Result<CameraPath, SceneError> {
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct PathFile {
+        keyframes: Vec<Spanned<KeyframeFile>>,
+    }
+    let cx = Context {
+        text,
+        path,
+        defined_materials: 0,
+    };
+    let file: PathFile = deserialize(&cx)?;
+    camera_path(&cx, &file.keyframes, camera, "keyframes")?.ok_or_else(|| {
+        cx.error(
+            0..0,
+            "keyframes",
+            "a camera path needs at least one keyframe",
+        )
+    })
+}
+
+/// `cx.text` deserialized as `T`, each error placed and keyed.
+fn deserialize<T: serde::de::DeserializeOwned>(cx: &Context) -> Result<T, SceneError> {
+    let text = cx.text;
     // Syntax errors have a place but no key; type errors get their key path
     // (`objects[0].radius`, the style of every other error) from
     // serde_path_to_error and their place from toml's span.
@@ -273,15 +309,21 @@ pub fn parse(text: &str, path: &Path, files: &dyn FileSource) -> Result<Scene, S
             _ => cx.error(span, "(syntax)", message.to_owned()),
         }
     })?;
-    let file: SceneFile = serde_path_to_error::deserialize(de).map_err(|e| {
-        // `Spanned` values add a private segment to the path: drop it.
+    serde_path_to_error::deserialize(de).map_err(|e| {
+        // `Spanned` values add private segments to the path (before the
+        // fields of a spanned table): drop them.
         let path = e
             .path()
             .to_string()
-            .split(".$__")
-            .next()
-            .unwrap_or_default()
-            .to_string();
+            .split('.')
+            .filter(|segment| !segment.starts_with("$__"))
+            .collect::<Vec<_>>()
+            .join(".");
+        let path = if path.is_empty() {
+            ".".to_owned()
+        } else {
+            path
+        };
         let inner = e.into_inner();
         let key = if path == "." {
             "(top level)".to_string()
@@ -293,8 +335,15 @@ pub fn parse(text: &str, path: &Path, files: &dyn FileSource) -> Result<Scene, S
             &key,
             plain_types(inner.message().trim()),
         )
-    })?;
+    })
+}
 
+fn parse_file(
+    cx: &mut Context,
+    file: &SceneFile,
+    path: &Path,
+    files: &dyn FileSource,
+) -> Result<Scene, SceneError> {
     let camera = CameraSpec {
         eye: cx.vec3(&file.camera.eye, "camera.eye")?,
         lookat: cx.vec3(&file.camera.lookat, "camera.lookat")?,
@@ -309,7 +358,7 @@ pub fn parse(text: &str, path: &Path, files: &dyn FileSource) -> Result<Scene, S
         };
         return Err(cx.error(span, &format!("camera.{key}"), message));
     }
-    let camera_path = camera_path(&cx, &file.camera.keyframes, &camera)?;
+    let camera_path = camera_path(cx, &file.camera.keyframes, &camera, "camera.keyframes")?;
 
     let mut image = ImageSettings::default();
     let im = &file.image;
@@ -432,13 +481,14 @@ fn camera_path(
     cx: &Context,
     keys: &[Spanned<KeyframeFile>],
     camera: &CameraSpec,
+    table: &str,
 ) -> Result<Option<CameraPath>, SceneError> {
     if keys.is_empty() {
         return Ok(None);
     }
     let mut keyframes = Vec::with_capacity(keys.len());
     for (i, k) in keys.iter().enumerate() {
-        let key = |name: &str| format!("camera.keyframes[{i}].{name}");
+        let key = |name: &str| format!("{table}[{i}].{name}");
         let f = k.get_ref();
         let spec = CameraSpec {
             eye: cx.vec3(&f.eye, &key("eye"))?,
@@ -472,11 +522,7 @@ fn camera_path(
             } else {
                 f.eye.span()
             };
-            cx.error(
-                span,
-                &format!("camera.keyframes[{index}].{name}"),
-                e.to_string(),
-            )
+            cx.error(span, &format!("{table}[{index}].{name}"), e.to_string())
         })
         .map(Some)
 }

@@ -319,3 +319,67 @@ fn sequence_flags_say_what_they_need() {
     let e = error(&["render", scene, "--turntable", "3", "--fps", "0", "-o", out]);
     assert!(e.contains("--fps"), "{e}");
 }
+
+#[test]
+fn an_nff_scene_flies_along_a_keyframes_file_and_a_bad_one_names_its_place() {
+    let tmp = common::temp_dir();
+    let scene = common::repo_path("scenes/spd/balls.nff");
+    let keys = common::repo_path("scenes/paths/balls_flight.toml");
+    let pattern = tmp.path().join("b_##.png");
+    let said = ok(&glint(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--path-file",
+        keys.to_str().unwrap(),
+        "--frames",
+        "3",
+        "-o",
+        pattern.to_str().unwrap(),
+        "--width",
+        "32",
+        "--height",
+        "24",
+    ]));
+    assert!(said.contains("wrote 3 frames"), "{said}");
+    let info = glint(&["info", tmp.path().join("b_01.png").to_str().unwrap()]);
+    let info = String::from_utf8_lossy(&info.stdout).into_owned();
+    assert!(
+        info.contains("frame         1 of 3, at 4 s along the camera path"),
+        "{info}"
+    );
+    // The first frame is the SPD view itself: the plain render's pixels.
+    let plain = tmp.path().join("plain.png");
+    ok(&glint(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        plain.to_str().unwrap(),
+        "--width",
+        "32",
+        "--height",
+        "24",
+    ]));
+    assert_eq!(pixels(&tmp.path().join("b_00.png")), pixels(&plain));
+
+    let bad = tmp.path().join("bad.toml");
+    std::fs::write(
+        &bad,
+        "[[keyframes]]\ntime = 0\neye = [1, 1, 1]\nlookat = [0, 0, 0]\n\n\
+         [[keyframes]]\ntime = 1\neye = [2, 2, 2]\nlookat = [0, 0]\n",
+    )
+    .unwrap();
+    let out = glint(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--path-file",
+        bad.to_str().unwrap(),
+        "-o",
+        pattern.to_str().unwrap(),
+    ]);
+    let e = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!out.status.success());
+    assert!(
+        e.contains("bad.toml:9:10") && e.contains("keyframes[1].lookat"),
+        "{e}"
+    );
+}

@@ -32,17 +32,24 @@ pub struct SequenceArgs {
     /// as for --turntable.
     #[arg(long, conflicts_with_all = ["from_png", "trace_pixel", "stats"])]
     pub path: bool,
+    /// Render the camera path in this TOML file of `[[keyframes]]` (time,
+    /// eye, lookat; up and fov default to the scene's camera) instead of
+    /// the scene's own: for NFF and OBJ scenes, which cannot hold one.
+    /// Implies --path.
+    #[arg(long, value_name = "KEYFRAMES.toml",
+          conflicts_with_all = ["from_png", "trace_pixel", "stats", "turntable"])]
+    pub path_file: Option<PathBuf>,
     /// Frames per second of --path's frames and of --animation
     /// (default 24).
     #[arg(long)]
     pub fps: Option<f64>,
     /// How many seconds of the camera path --path renders (default: all
     /// of it).
-    #[arg(long, requires = "path")]
+    #[arg(long)]
     pub seconds: Option<f64>,
     /// How many frames --path renders (default: --seconds times --fps,
     /// plus the frame at the end).
-    #[arg(long, requires = "path", value_parser = parse_frame_count)]
+    #[arg(long, value_parser = parse_frame_count)]
     pub frames: Option<u32>,
     /// Also write the whole sequence as one animated PNG (APNG, looping,
     /// at --fps), which browsers and most image viewers play.
@@ -61,7 +68,7 @@ fn parse_frame_count(s: &str) -> std::result::Result<u32, String> {
 
 impl SequenceArgs {
     pub fn is_sequence(&self) -> bool {
-        self.turntable.is_some() || self.path
+        self.turntable.is_some() || self.path || self.path_file.is_some()
     }
 
     /// Flags that only mean something in a sequence are refused alone.
@@ -71,6 +78,15 @@ impl SequenceArgs {
                 self.fps.is_none() && self.animation.is_none(),
                 "--fps and --animation belong to a sequence: add --turntable N or --path"
             );
+        }
+        anyhow::ensure!(
+            (self.seconds.is_none() && self.frames.is_none())
+                || self.path
+                || self.path_file.is_some(),
+            "--seconds and --frames time a camera path: add --path (or --path-file); a \
+             turntable's frame count is --turntable N"
+        );
+        if !self.is_sequence() {
             return Ok(());
         }
         let Some(output) = &args.output else {
@@ -257,10 +273,15 @@ fn cameras(seq: &SequenceArgs, job: &Prepared) -> Result<(Vec<(Option<f64>, Came
         let cameras = turntable(&job.camera, n).into_iter().map(|c| (None, c));
         return Ok((cameras.collect(), fps));
     }
-    let Some(path) = &job.scene.camera_path else {
+    let from_file = match &seq.path_file {
+        Some(file) => Some(glint::scene::load_camera_path(file, &job.camera)?),
+        None => None,
+    };
+    let Some(path) = from_file.as_ref().or(job.scene.camera_path.as_ref()) else {
         anyhow::bail!(
             "{} has no camera path: give it [[camera.keyframes]] (time, eye, lookat; \
-             scenes/README.md), record one in the viewer, or render --turntable N",
+             scenes/README.md; --path-file KEYFRAMES.toml for NFF and OBJ scenes), record \
+             one in the viewer, or render --turntable N",
             job.scene_name
         );
     };
