@@ -56,7 +56,7 @@ pub enum PathError {
 
 /// How many frames a sequence has and where they fall in time: any two of
 /// frames, frames per second and seconds (the rest follow); see
-/// [`FrameTiming::times`].
+/// [`FrameTiming::resolve`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FrameTiming {
     pub fps: Option<f64>,
@@ -78,12 +78,12 @@ impl FrameTiming {
     pub fn resolve(&self, duration: f64) -> Result<(f64, u32), PathError> {
         let bad = |m: &str| Err(PathError::Timing(m.to_owned()));
         if let Some(f) = self.fps
-            && !(f.is_finite() && f > 0.0 && f <= 1000.0)
+            && !(f > 0.0 && f <= 1000.0)
         {
             return bad("--fps must lie between 0 and 1000 frames per second");
         }
         if let Some(s) = self.seconds
-            && !(s.is_finite() && s >= 0.0 && s <= 1e6)
+            && !(0.0..=1e6).contains(&s)
         {
             return bad("--seconds must lie between 0 and 1,000,000");
         }

@@ -467,7 +467,7 @@ fn parse_file(
     scene.materials = materials;
     scene.lights = lights;
     for (i, obj) in file.objects.iter().enumerate() {
-        add_object(&cx, &mut scene, i, obj, files)?;
+        add_object(cx, &mut scene, i, obj, files)?;
     }
     if file.octree.leaf_size.is_none() {
         scene.octree_params.leaf_size = OctreeParams::default_for(&scene.shapes).leaf_size;

@@ -130,6 +130,10 @@ pub fn frame_file(pattern: &Path, index: u32) -> PathBuf {
     pattern.with_file_name(format!("{head}{number}{tail}"))
 }
 
+/// The cameras of a sequence, each with its time along the path (none
+/// for a turntable).
+type TimedCameras = Vec<(Option<f64>, CameraSpec)>;
+
 /// One frame to make: its camera and place in the sequence.
 struct SequenceFrame {
     camera: CameraSpec,
@@ -262,7 +266,7 @@ pub fn run(args: &RenderArgs, job: &Prepared) -> Result<()> {
 
 /// The sequence's cameras (with their time along the path) and its frame
 /// rate.
-fn cameras(seq: &SequenceArgs, job: &Prepared) -> Result<(Vec<(Option<f64>, CameraSpec)>, f64)> {
+fn cameras(seq: &SequenceArgs, job: &Prepared) -> Result<(TimedCameras, f64)> {
     let timing = FrameTiming {
         fps: seq.fps,
         seconds: seq.seconds,
