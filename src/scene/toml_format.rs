@@ -1,7 +1,7 @@
 //! glint's own scene format; every key is documented in `scenes/README.md`.
 
 use std::collections::BTreeMap;
-use std::ops::{Range, RangeInclusive};
+use std::ops::Range;
 use std::path::Path;
 
 use serde::Deserialize;
@@ -9,20 +9,23 @@ use toml::Spanned;
 
 use super::file_source::FileSource;
 use super::mesh::{Placement, parse_obj};
-use super::model::{ImageSettings, Location, Scene, SceneError, line_column};
+use super::model::{ImageSettings, Scene, SceneError};
 use crate::accel::OctreeParams;
 use crate::camera::CameraSpec;
-use crate::camera_path::{CameraPath, Keyframe, PathError};
 use crate::limits::{
     INTENSITY_RANGE, IOR_RANGE, MAX_IMAGE_SIDE, MAX_RAY_DEPTH, SHININESS_RANGE, UNIT_RANGE,
-    check_color, check_finite, check_finite_vec3, check_integer, check_range,
 };
 use crate::material::{Light, Material};
 use crate::math::{Aabb, DVec3};
 use crate::settings::AntiAliasing;
 use crate::shapes::{Plane, Quadric, Shape, Sphere, Triangle};
 
-type Vec3 = Spanned<[f64; 3]>;
+mod context;
+mod keyframes;
+
+use context::{Context, Vec3, deserialize};
+pub use keyframes::parse_camera_path;
+use keyframes::{KeyframeFile, camera_path};
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -50,17 +53,6 @@ struct CameraFile {
     /// The camera path, in increasing time.
     #[serde(default)]
     keyframes: Vec<Spanned<KeyframeFile>>,
-}
-
-/// One key of the camera path: `up` and `fov` default to the camera's.
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct KeyframeFile {
-    time: Spanned<f64>,
-    eye: Vec3,
-    lookat: Vec3,
-    up: Option<Vec3>,
-    fov: Option<Spanned<f64>>,
 }
 
 #[derive(Deserialize, Default)]
@@ -138,56 +130,8 @@ struct ObjectFile {
     materials: Option<Spanned<BTreeMap<Spanned<String>, MaterialFile>>>,
 }
 
-struct Context<'a> {
-    text: &'a str,
-    path: &'a Path,
-    /// How many materials the file defines (meshes add theirs behind).
-    defined_materials: usize,
-}
-
+/// Materials are read with the names and ranges of this format.
 impl Context<'_> {
-    fn location(&self, span: Range<usize>, key: &str) -> Location {
-        let (line, column) = line_column(self.text, span.start);
-        Location {
-            path: self.path.to_owned(),
-            line,
-            column,
-            key: key.to_owned(),
-        }
-    }
-
-    fn error(&self, span: Range<usize>, key: &str, message: impl Into<String>) -> SceneError {
-        SceneError::Invalid {
-            location: self.location(span, key),
-            message: message.into(),
-        }
-    }
-
-    fn finite(&self, v: &Spanned<f64>, key: &str) -> Result<f64, SceneError> {
-        check_finite(*v.get_ref()).map_err(|e| self.error(v.span(), key, e))
-    }
-
-    fn vec3(&self, v: &Vec3, key: &str) -> Result<DVec3, SceneError> {
-        check_finite_vec3(DVec3::from(*v.get_ref())).map_err(|e| self.error(v.span(), key, e))
-    }
-
-    /// A colour whose components lie in `range` (surface colours in
-    /// [0, 1], intensities in [0, 1000]).
-    fn color(&self, v: &Vec3, key: &str, range: &RangeInclusive<f64>) -> Result<DVec3, SceneError> {
-        let c = self.vec3(v, key)?;
-        check_color(c, range).map_err(|e| self.error(v.span(), key, e))
-    }
-
-    fn in_range(
-        &self,
-        v: &Spanned<f64>,
-        key: &str,
-        range: &RangeInclusive<f64>,
-    ) -> Result<f64, SceneError> {
-        let x = self.finite(v, key)?;
-        check_range(x, range).map_err(|e| self.error(v.span(), key, e))
-    }
-
     /// `base` with the keys `m` gives; `prefix` names the table in errors.
     fn material(
         &self,
@@ -228,29 +172,6 @@ impl Context<'_> {
         }
         Ok(mat)
     }
-
-    fn integer(&self, v: &Spanned<i64>, key: &str, range: Range<i64>) -> Result<u32, SceneError> {
-        check_integer(*v.get_ref(), &(range.start..=range.end - 1))
-            .map_err(|e| self.error(v.span(), key, e))
-    }
-}
-
-/// serde's words for the types it expected, in a scene author's: `f64`
-/// is a number, `i64` and the other integers a whole number.
-fn plain_types(message: &str) -> String {
-    let mut out = message.to_owned();
-    for (rust, plain) in [
-        ("expected f64", "expected a number"),
-        ("expected f32", "expected a number"),
-        ("expected i64", "expected a whole number"),
-        ("expected u64", "expected a whole number"),
-        ("expected u32", "expected a whole number"),
-        ("expected i32", "expected a whole number"),
-        ("expected usize", "expected a whole number"),
-    ] {
-        out = out.replace(rust, plain);
-    }
-    out
 }
 
 pub fn parse(text: &str, path: &Path, files: &dyn FileSource) -> Result<Scene, SceneError> {
@@ -261,81 +182,6 @@ pub fn parse(text: &str, path: &Path, files: &dyn FileSource) -> Result<Scene, S
     };
     let file: SceneFile = deserialize(&cx)?;
     parse_file(&mut cx, &file, path, files)
-}
-
-/// A camera path on its own: a TOML file of `[[keyframes]]` (time, eye,
-/// lookat, and up and fov defaulting to `camera`'s), for scenes whose
-/// format has no place for one (NFF, OBJ). Errors name `path`, the line,
-/// the column and the key.
-pub fn parse_camera_path(
-    text: &str,
-    path: &Path,
-    camera: &CameraSpec,
-) -> Result<CameraPath, SceneError> {
-    #[derive(Deserialize)]
-    #[serde(deny_unknown_fields)]
-    struct PathFile {
-        keyframes: Vec<Spanned<KeyframeFile>>,
-    }
-    let cx = Context {
-        text,
-        path,
-        defined_materials: 0,
-    };
-    let file: PathFile = deserialize(&cx)?;
-    camera_path(&cx, &file.keyframes, camera, "keyframes")?.ok_or_else(|| {
-        cx.error(
-            0..0,
-            "keyframes",
-            "a camera path needs at least one keyframe",
-        )
-    })
-}
-
-/// `cx.text` deserialized as `T`, each error placed and keyed.
-fn deserialize<T: serde::de::DeserializeOwned>(cx: &Context) -> Result<T, SceneError> {
-    let text = cx.text;
-    // Syntax errors have a place but no key; type errors get their key path
-    // (`objects[0].radius`, the style of every other error) from
-    // serde_path_to_error and their place from toml's span.
-    let de = toml::de::Deserializer::parse(text).map_err(|e| {
-        let span = e.span().unwrap_or(0..0);
-        // A key written twice is named: its span is the key.
-        let message = e.message().trim();
-        match text.get(span.clone()).map(str::trim) {
-            Some(k) if message == "duplicate key" && !k.is_empty() => {
-                cx.error(span, k, "written twice in its table")
-            }
-            _ => cx.error(span, "(syntax)", message.to_owned()),
-        }
-    })?;
-    serde_path_to_error::deserialize(de).map_err(|e| {
-        // `Spanned` values add private segments to the path (before the
-        // fields of a spanned table): drop them.
-        let path = e
-            .path()
-            .to_string()
-            .split('.')
-            .filter(|segment| !segment.starts_with("$__"))
-            .collect::<Vec<_>>()
-            .join(".");
-        let path = if path.is_empty() {
-            ".".to_owned()
-        } else {
-            path
-        };
-        let inner = e.into_inner();
-        let key = if path == "." {
-            "(top level)".to_string()
-        } else {
-            path
-        };
-        cx.error(
-            inner.span().unwrap_or(0..0),
-            &key,
-            plain_types(inner.message().trim()),
-        )
-    })
 }
 
 fn parse_file(
@@ -473,58 +319,6 @@ fn parse_file(
         scene.octree_params.leaf_size = OctreeParams::default_for(&scene.shapes).leaf_size;
     }
     Ok(scene)
-}
-
-/// The scene's camera path from its keyframes (none without any), each
-/// error pointing at the key at fault.
-fn camera_path(
-    cx: &Context,
-    keys: &[Spanned<KeyframeFile>],
-    camera: &CameraSpec,
-    table: &str,
-) -> Result<Option<CameraPath>, SceneError> {
-    if keys.is_empty() {
-        return Ok(None);
-    }
-    let mut keyframes = Vec::with_capacity(keys.len());
-    for (i, k) in keys.iter().enumerate() {
-        let key = |name: &str| format!("{table}[{i}].{name}");
-        let f = k.get_ref();
-        let spec = CameraSpec {
-            eye: cx.vec3(&f.eye, &key("eye"))?,
-            lookat: cx.vec3(&f.lookat, &key("lookat"))?,
-            up: match &f.up {
-                Some(up) => cx.vec3(up, &key("up"))?,
-                None => camera.up,
-            },
-            fov: match &f.fov {
-                Some(fov) => cx.finite(fov, &key("fov"))?,
-                None => camera.fov,
-            },
-        };
-        keyframes.push(Keyframe {
-            time: cx.finite(&f.time, &key("time"))?,
-            camera: spec,
-        });
-    }
-    CameraPath::new(keyframes)
-        .map_err(|e| {
-            let (index, name) = match &e {
-                PathError::TimeOrder { index, .. } | PathError::TimeNotFinite { index } => {
-                    (*index, "time")
-                }
-                PathError::Camera { index, .. } => (*index, "eye"),
-                _ => (0, "time"),
-            };
-            let f = keys[index].get_ref();
-            let span = if name == "time" {
-                f.time.span()
-            } else {
-                f.eye.span()
-            };
-            cx.error(span, &format!("{table}[{index}].{name}"), e.to_string())
-        })
-        .map(Some)
 }
 
 fn add_object(

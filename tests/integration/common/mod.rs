@@ -68,11 +68,15 @@ pub fn loaded(rel: &str) -> std::sync::Arc<(Scene, Octree)> {
     .clone()
 }
 
-/// Every scene file under `scenes/` (TOML and NFF, recursively), sorted.
+/// Every scene file under `scenes/` (TOML and NFF, recursively), sorted;
+/// not `scenes/paths/`, which holds camera paths for scenes.
 pub fn all_scenes() -> Vec<String> {
     fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
         for entry in std::fs::read_dir(dir).unwrap() {
             let p = entry.unwrap().path();
+            if p.ends_with("scenes/paths") {
+                continue;
+            }
             if p.is_dir() {
                 walk(&p, out);
             } else if matches!(p.extension().and_then(|e| e.to_str()), Some("toml" | "nff")) {
