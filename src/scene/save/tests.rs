@@ -541,3 +541,33 @@ fn a_camera_path_is_written_as_keyframes_and_reads_back_the_same() {
     .unwrap();
     assert!(saved.left_out.contains(&LeftOut::CameraPath));
 }
+
+#[test]
+fn an_edited_component_leaves_the_others_as_the_file_wrote_them() {
+    let loaded = scene(TEXT);
+    let settings = loaded.render_settings();
+    let mut lights = loaded.lights.clone();
+    lights[0].position.x = 2.5;
+    let mut materials = loaded.materials.clone();
+    materials[0].color.y = 0.25;
+    let mut camera = loaded.camera;
+    camera.eye.y = 1.5;
+    let req = SaveRequest {
+        lights: &lights,
+        materials: &materials,
+        ..request(&loaded, &camera, &settings)
+    };
+    let text = scene_toml(&req, Path::new("dir/scene.toml")).unwrap().text;
+    for written in [
+        "position = [2.5, 5, 1]\n",
+        "color = [0.8, 0.25, 0.1] # brick\n",
+        "eye = [0, 1.5, 5] # over the floor\n",
+    ] {
+        assert!(text.contains(written), "no {written:?} in\n{text}");
+    }
+    let again = scene(&text);
+    assert_eq!(
+        (again.lights, again.materials, again.camera),
+        (lights, materials, camera)
+    );
+}

@@ -61,6 +61,28 @@ pub fn scene_toml(request: &SaveRequest, destination: &Path) -> Result<SavedText
     })
 }
 
+/// Sets the three numbers at `key` to `new`, rewriting only those that
+/// differ from `old`: the others keep the file's spelling (`-3` stays `-3`,
+/// not `-3.0`), each its spacing. Anything else at `key` is replaced by
+/// the whole triple.
+fn set_vec3(t: &mut dyn TableLike, key: &str, old: DVec3, new: DVec3) {
+    if let Some(Item::Value(Value::Array(a))) = t.get_mut(key)
+        && a.len() == 3
+    {
+        for (i, (o, n)) in old.to_array().into_iter().zip(new.to_array()).enumerate() {
+            if o != n
+                && let Some(slot) = a.get_mut(i)
+            {
+                let mut v = Value::from(n);
+                *v.decor_mut() = slot.decor().clone();
+                *slot = v;
+            }
+        }
+        return;
+    }
+    set(t, key, vec3(new));
+}
+
 fn vec3(v: DVec3) -> Value {
     Value::Array(Array::from_iter([v.x, v.y, v.z]))
 }
@@ -85,7 +107,7 @@ fn write_camera(doc: &mut DocumentMut, loaded: &CameraSpec, camera: &CameraSpec)
         ("up", loaded.up, camera.up),
     ] {
         if old != new {
-            set(t, key, vec3(new));
+            set_vec3(t, key, old, new);
         }
     }
     if loaded.fov != camera.fov {
@@ -222,10 +244,10 @@ fn write_lights(doc: &mut DocumentMut, loaded: &[Light], lights: &[Light]) {
     };
     for ((t, old), new) in tables_of(item).into_iter().zip(loaded).zip(lights) {
         if old.position != new.position {
-            set(t, "position", vec3(new.position));
+            set_vec3(t, "position", old.position, new.position);
         }
         if old.color != new.color {
-            set(t, "color", vec3(new.color));
+            set_vec3(t, "color", old.color, new.color);
         }
     }
 }
@@ -285,7 +307,7 @@ fn mesh_material_table<'d>(
 
 fn write_material(t: &mut dyn TableLike, old: &Material, new: &Material) {
     if old.color != new.color {
-        set(t, "color", vec3(new.color));
+        set_vec3(t, "color", old.color, new.color);
     }
     for (key, a, b) in [
         ("kd", old.kd, new.kd),
