@@ -345,6 +345,69 @@ fn lights_ui(edit: &mut EditState, speed: f64, ui: &mut egui::Ui) {
     }
 }
 
+/// A number field held to `range` (the scene files' limit): a value typed
+/// or dragged past it is brought back to its end, and the field says so
+/// beside it ("2 is past 0 to 1: 1 kept") until the next edit. Returns
+/// whether the value changed.
+fn bounded_value_ui(
+    ui: &mut egui::Ui,
+    salt: impl std::hash::Hash + std::fmt::Debug,
+    value: &mut f64,
+    range: std::ops::RangeInclusive<f64>,
+    step: f64,
+) -> bool {
+    let id = ui.scope_id().with(("bounded", salt));
+    let response = ui
+        .add(
+            DragValue::new(value)
+                .update_while_editing(false)
+                .speed(step),
+        )
+        .on_hover_text(format!(
+            "from {} to {}, as scene files allow",
+            range.start(),
+            range.end()
+        ));
+    if response.changed() {
+        let note = clamp_note(value, &range);
+        ui.data_mut(|d| match note {
+            Some(n) => {
+                d.insert_temp(id, n);
+            }
+            None => d.remove::<String>(id),
+        });
+    }
+    match ui.data(|d| d.get_temp::<String>(id)) {
+        Some(note) => {
+            ui.colored_label(ui.visuals().warn_fg_color, note);
+        }
+        None => {
+            ui.label("");
+        }
+    }
+    response.changed()
+}
+
+/// `value` brought into `range` if it lies past it (or is not a number),
+/// and the words that say so.
+fn clamp_note(value: &mut f64, range: &std::ops::RangeInclusive<f64>) -> Option<String> {
+    if range.contains(value) {
+        return None;
+    }
+    let asked = *value;
+    *value = if asked > *range.end() {
+        *range.end()
+    } else {
+        *range.start()
+    };
+    Some(format!(
+        "{asked} is past {} to {}: {} kept",
+        range.start(),
+        range.end(),
+        value
+    ))
+}
+
 /// Every material's colour and coefficients, within the ranges scene files
 /// are held to.
 fn materials_ui(edit: &mut EditState, ui: &mut egui::Ui) {
@@ -359,7 +422,7 @@ fn materials_ui(edit: &mut EditState, ui: &mut egui::Ui) {
             .show(ui, |ui| {
                 changed |= color_ui(ui, "colour", &mut m.color);
                 egui::Grid::new(("material-grid", i))
-                    .num_columns(2)
+                    .num_columns(3)
                     .show(ui, |ui| {
                         // The ranges scene files are held to.
                         use crate::limits::{IOR_RANGE, SHININESS_RANGE, UNIT_RANGE};
@@ -372,14 +435,7 @@ fn materials_ui(edit: &mut EditState, ui: &mut egui::Ui) {
                             ("ior", &mut m.ior, IOR_RANGE, 0.005),
                         ] {
                             ui.label(label);
-                            changed |= ui
-                                .add(
-                                    DragValue::new(value)
-                                        .update_while_editing(false)
-                                        .range(range)
-                                        .speed(step),
-                                )
-                                .changed();
+                            changed |= bounded_value_ui(ui, (i, label), value, range, step);
                             ui.end_row();
                         }
                     });
@@ -578,6 +634,22 @@ mod tests {
         assert_eq!(seconds_text(42.4), "42 s");
         assert_eq!(seconds_text(185.0), "3 min 5 s");
         assert_eq!(seconds_text(4320.0), "1 h 12 min");
+    }
+
+    #[test]
+    fn a_value_past_its_range_is_brought_back_and_said() {
+        let mut kd = 2.0;
+        assert_eq!(
+            clamp_note(&mut kd, &(0.0..=1.0)).as_deref(),
+            Some("2 is past 0 to 1: 1 kept")
+        );
+        assert_eq!(kd, 1.0);
+        let mut ior = 0.001;
+        assert!(clamp_note(&mut ior, &crate::limits::IOR_RANGE).is_some());
+        assert_eq!(ior, *crate::limits::IOR_RANGE.start());
+        let mut inside = 0.5;
+        assert_eq!(clamp_note(&mut inside, &(0.0..=1.0)), None);
+        assert_eq!(inside, 0.5);
     }
 
     #[test]

@@ -503,6 +503,10 @@ fn a_screenshot_path_is_checked_before_the_window_and_no_file_is_touched() {
         let err = stderr(&o);
         assert_eq!(o.status.code(), Some(1), "{}: {err}", path.display());
         assert!(err.contains("--screenshot"), "{err}");
+        if path == &missing {
+            // The reason, as `glint render -o` gives it.
+            assert!(err.contains("No such file or directory"), "{err}");
+        }
         assert!(
             !err.contains("no display"),
             "refused before the window: {err}"
@@ -710,4 +714,57 @@ fn max_depth_is_refused_alike_at_both_ends() {
         assert_eq!(out.status.code(), Some(2), "--max-depth {depth}");
         assert!(String::from_utf8_lossy(&out.stderr).contains("expected a ray depth from 1 to 64"));
     }
+}
+
+/// Ctrl+C during a render on a terminal ends the progress bar's line, so
+/// the shell's prompt starts on a line of its own. `script` gives glint a
+/// terminal; the byte 0x03 typed into it is the terminal's Ctrl+C.
+#[test]
+fn ctrl_c_on_a_terminal_ends_the_progress_line() {
+    use std::io::{Read, Write};
+    use std::process::Stdio;
+    if Command::new("script").arg("--version").output().is_err() {
+        eprintln!("skipped: no `script` (util-linux) to give glint a terminal");
+        return;
+    }
+    let tmp = common::temp_dir();
+    let out = tmp.path().join("big.png");
+    let line = format!(
+        "{} render {} --width 1600 --height 1200 --aa full --threads 1 -o {}",
+        env!("CARGO_BIN_EXE_glint"),
+        common::repo_path("scenes/default.toml").display(),
+        out.display()
+    );
+    let mut child = Command::new("script")
+        .args(["-qfec", &line, "/dev/null"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut stdout = child.stdout.take().unwrap();
+    // Wait for the bar, then type Ctrl+C.
+    let mut seen = Vec::new();
+    let mut buf = [0u8; 4096];
+    while !String::from_utf8_lossy(&seen).contains("rendering") {
+        let n = stdout.read(&mut buf).unwrap();
+        assert!(
+            n > 0,
+            "glint ended before its progress bar: {}",
+            String::from_utf8_lossy(&seen)
+        );
+        seen.extend_from_slice(&buf[..n]);
+    }
+    child.stdin.as_mut().unwrap().write_all(b"\x03").unwrap();
+    stdout.read_to_end(&mut seen).unwrap();
+    let status = child.wait().unwrap();
+    assert!(!status.success(), "interrupted");
+    let text = String::from_utf8_lossy(&seen);
+    let last = text.rfind("rendering").unwrap();
+    assert!(
+        text[last..].contains('\n'),
+        "the progress line was left open: {:?}",
+        &text[last..]
+    );
+    assert!(!out.exists(), "no partial image");
 }

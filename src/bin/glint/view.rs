@@ -137,8 +137,9 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     // output, before minutes of rendering: a PNG name in a folder that
     // takes a new file, never the scene itself.
     if let Some(shot) = &args.screenshot {
+        // The error's source says why (no such folder, no permission).
         glint::export::check_output(shot, args.scene.as_deref())
-            .map_err(|e| anyhow!("--screenshot: {e}"))?;
+            .map_err(|e| anyhow::Error::new(e).context("--screenshot"))?;
     }
     // The previews' folder too, before the drag: not after minutes of it.
     if let Some(dir) = &args.save_previews {
