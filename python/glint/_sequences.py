@@ -194,6 +194,8 @@ def render_frames(scene, cameras, width=None, height=None, *, out=None, client=N
     has its tasks run again elsewhere, and each frame is yielded once. A
     scene the workers cannot load raises its :class:`SceneError` here,
     once, and the remaining tasks are cancelled."""
+    if not (isinstance(chunk, int) and chunk >= 1):
+        raise ValueError(f"chunk is how many frames a task renders, at least 1, got {chunk!r}")
     views = [as_viewpoint(c) for c in cameras]
     count = len(views)
     flags = dict(render_flags, width=width, height=height)
@@ -222,8 +224,6 @@ def _render_on_dask(scene, views, flags, client, chunk, finished):
     from distributed import as_completed
     from ._frame import Frame
 
-    if not (isinstance(chunk, int) and chunk >= 1):
-        raise ValueError(f"chunk is how many frames a task renders, at least 1, got {chunk!r}")
     count = len(views)
     task_flags = {k: v for k, v in flags.items() if k not in ("cancel",)}
     # The scene travels once to every worker; tasks name it. (In a list:

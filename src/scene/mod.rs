@@ -33,22 +33,15 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     load_with(path, &FileSystem)
 }
 
-/// A camera path from a TOML file of `[[keyframes]]` (for scenes whose
-/// format has no place for one: NFF, OBJ); `up` and `fov` default to
-/// `camera`'s.
-pub fn load_camera_path(
+/// A camera path from the text of a TOML file of `[[keyframes]]` (for
+/// scenes whose format has no place for one: NFF, OBJ); `path` names it
+/// in errors; `up` and `fov` default to `camera`'s.
+pub fn camera_path_from_str(
+    text: &str,
     path: &Path,
     camera: &crate::camera::CameraSpec,
 ) -> Result<crate::camera_path::CameraPath, SceneError> {
-    let bytes = FileSystem.read(path).map_err(|source| SceneError::Io {
-        path: path.to_owned(),
-        source,
-    })?;
-    let text = String::from_utf8(bytes).map_err(|e| SceneError::NotUtf8 {
-        path: path.to_owned(),
-        offset: e.utf8_error().valid_up_to(),
-    })?;
-    toml_format::parse_camera_path(&text, path, camera)
+    toml_format::parse_camera_path(text, path, camera)
 }
 
 /// Like [`load`], reading the scene file and its meshes from `files`.

@@ -383,3 +383,39 @@ fn an_nff_scene_flies_along_a_keyframes_file_and_a_bad_one_names_its_place() {
         "{e}"
     );
 }
+
+#[test]
+fn an_animation_named_as_a_frame_and_a_missing_keyframes_file_are_refused() {
+    let tmp = common::temp_dir();
+    let scene = common::repo_path("scenes/sphere.toml");
+    let frame0 = tmp.path().join("t_0.png");
+    let o = glint(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--turntable",
+        "2",
+        "-o",
+        tmp.path().join("t_#.png").to_str().unwrap(),
+        "--animation",
+        frame0.to_str().unwrap(),
+    ]);
+    let e = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert!(
+        !o.status.success() && e.contains("also the name of frame 0"),
+        "{e}"
+    );
+    assert!(!frame0.exists(), "refused before any frame");
+    let o = glint(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--path-file",
+        tmp.path().join("nope.toml").to_str().unwrap(),
+        "-o",
+        tmp.path().join("p_#.png").to_str().unwrap(),
+    ]);
+    let e = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert!(
+        e.contains("cannot read the camera path file") && e.contains("No such file"),
+        "{e}"
+    );
+}

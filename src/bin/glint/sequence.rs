@@ -171,6 +171,15 @@ pub fn run(args: &RenderArgs, job: &Prepared) -> Result<()> {
             )
         })?;
     }
+    if let Some(animation) = &seq.animation
+        && let Some(f) = frames.iter().find(|f| same_path(&f.file, animation))
+    {
+        anyhow::bail!(
+            "--animation {} is also the name of frame {}: give the animation a name of its own",
+            animation.display(),
+            f.recorded.index
+        );
+    }
     let first = &frames[0].file;
     for file in std::iter::once(first).chain(&seq.animation) {
         if let Some(dir) = file.parent().filter(|d| !d.as_os_str().is_empty()) {
@@ -264,6 +273,17 @@ pub fn run(args: &RenderArgs, job: &Prepared) -> Result<()> {
     Ok(())
 }
 
+/// Whether `a` and `b` name the same file (absolute, `.` and `..` taken
+/// out; through links where the file is already there).
+fn same_path(a: &Path, b: &Path) -> bool {
+    let resolve = |p: &Path| {
+        std::fs::canonicalize(p)
+            .or_else(|_| std::path::absolute(p))
+            .map(|p| p.components().collect::<PathBuf>())
+    };
+    matches!((resolve(a), resolve(b)), (Ok(x), Ok(y)) if x == y)
+}
+
 /// The sequence's cameras (with their time along the path) and its frame
 /// rate.
 fn cameras(seq: &SequenceArgs, job: &Prepared) -> Result<(TimedCameras, f64)> {
@@ -278,7 +298,15 @@ fn cameras(seq: &SequenceArgs, job: &Prepared) -> Result<(TimedCameras, f64)> {
         return Ok((cameras.collect(), fps));
     }
     let from_file = match &seq.path_file {
-        Some(file) => Some(glint::scene::load_camera_path(file, &job.camera)?),
+        Some(file) => {
+            let text = std::fs::read_to_string(file)
+                .with_context(|| format!("cannot read the camera path file {}", file.display()))?;
+            Some(glint::scene::camera_path_from_str(
+                &text,
+                file,
+                &job.camera,
+            )?)
+        }
         None => None,
     };
     let Some(path) = from_file.as_ref().or(job.scene.camera_path.as_ref()) else {
