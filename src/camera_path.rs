@@ -98,6 +98,9 @@ impl FrameTiming {
                 return bad("give at most two of --fps, --seconds and --frames");
             }
             (Some(fps), Some(n)) => (fps, n),
+            (None, Some(n)) if n > 1 && self.seconds == Some(0.0) => {
+                return bad("--seconds 0 holds one frame: give --frames 1, or more seconds");
+            }
             (None, Some(n)) => {
                 let fps = if n > 1 && seconds > 0.0 {
                     f64::from(n - 1) / seconds
@@ -427,6 +430,8 @@ mod tests {
         );
         assert_eq!(t(None, None, Some(1)).resolve(0.0).unwrap(), (24.0, 1));
         assert!(t(Some(1.0), Some(1.0), Some(1)).resolve(3.0).is_err());
+        assert!(t(None, Some(0.0), Some(2)).resolve(3.0).is_err());
+        assert_eq!(t(None, Some(0.0), Some(1)).resolve(3.0).unwrap(), (24.0, 1));
         assert!(t(Some(0.0), None, None).resolve(3.0).is_err());
         assert!(t(None, None, Some(0)).resolve(3.0).is_err());
         assert!(t(Some(1000.0), Some(1e6), None).resolve(3.0).is_err());

@@ -282,14 +282,26 @@ pub fn save_animation(
     })
 }
 
-/// An APNG frame's display time for `fps`: 1/fps seconds as a fraction
-/// with 16-bit parts (hundredths of a frame while they fit).
+/// An APNG frame's display time for `fps`: the fraction with 16-bit parts
+/// nearest 1/fps seconds (the smallest denominator among equals, so 24 fps
+/// is 1/24 and 0.4 fps 5/2).
 fn frame_delay(fps: f64) -> (u16, u16) {
-    if fps * 100.0 <= f64::from(u16::MAX) {
-        (100, (fps * 100.0).round().max(1.0) as u16)
-    } else {
-        (1, fps.round().min(f64::from(u16::MAX)) as u16)
+    let seconds = 1.0 / fps;
+    let mut best = (1u16, 1u16);
+    let mut best_error = f64::INFINITY;
+    for den in 1..=u16::MAX {
+        let num = (seconds * f64::from(den))
+            .round()
+            .clamp(1.0, f64::from(u16::MAX));
+        let error = (num / f64::from(den) - seconds).abs();
+        if error < best_error {
+            (best, best_error) = ((num as u16, den), error);
+            if error == 0.0 {
+                break;
+            }
+        }
     }
+    best
 }
 
 /// Runs `write` on where `path` leads: standard output for `-`, FIFOs and
@@ -391,6 +403,20 @@ mod tests {
     fn listed(path: &Path) -> bool {
         let list = UNFINISHED.lock().unwrap_or_else(|e| e.into_inner());
         list.iter().any(|p| p == path)
+    }
+
+    #[test]
+    fn frame_delays_are_the_nearest_16_bit_fractions() {
+        assert_eq!(frame_delay(24.0), (1, 24));
+        assert_eq!(frame_delay(12.0), (1, 12));
+        assert_eq!(frame_delay(0.4), (5, 2));
+        assert_eq!(frame_delay(0.001), (1000, 1));
+        // 7 frames over 9 s: 1.5 s each.
+        assert_eq!(frame_delay(6.0 / 9.0), (3, 2));
+        // Past what 16 bits hold: the nearest they can.
+        assert_eq!(frame_delay(1e-6), (u16::MAX, 1));
+        let (n, d) = frame_delay(29.97);
+        assert!((f64::from(n) / f64::from(d) - 1.0 / 29.97).abs() < 1e-8);
     }
 
     // Removal itself is `tests/integration/cli_output.rs`'s: calling it here would

@@ -87,7 +87,7 @@ fn a_turntable_writes_frames_that_render_again_byte_for_byte_and_an_animation() 
             "frame {k}"
         );
         let fc = reader.info().frame_control.unwrap();
-        assert_eq!((fc.delay_num, fc.delay_den), (100, 2400), "24 fps");
+        assert_eq!((fc.delay_num, fc.delay_den), (1, 24), "24 fps");
     }
 }
 
@@ -405,6 +405,23 @@ fn an_animation_named_as_a_frame_and_a_missing_keyframes_file_are_refused() {
         "{e}"
     );
     assert!(!frame0.exists(), "refused before any frame");
+    // The same file by another spelling, in a folder not there yet.
+    let fresh = tmp.path().join("new");
+    let o = glint(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--turntable",
+        "2",
+        "-o",
+        fresh.join("t_#.png").to_str().unwrap(),
+        "--animation",
+        fresh.join("../new/t_1.png").to_str().unwrap(),
+    ]);
+    let e = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert!(
+        !o.status.success() && e.contains("also the name of frame 1"),
+        "{e}"
+    );
     let o = glint(&[
         "render",
         scene.to_str().unwrap(),

@@ -65,6 +65,9 @@ fn a_path_recorded_while_orbiting_saves_undoes_and_plays_back() {
     let before_play = *h.state().camera();
     press(&mut h, Modifiers::NONE, Key::P);
     assert!(h.state().is_playing_path());
+    // Recording is not started while playing (the camera is the path's).
+    press(&mut h, Modifiers::COMMAND, Key::R);
+    assert!(h.state().is_playing_path() && !h.state().is_recording_path());
     let mut followed = false;
     let waited = std::time::Instant::now();
     while h.state().is_playing_path() {

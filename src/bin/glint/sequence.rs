@@ -171,6 +171,15 @@ pub fn run(args: &RenderArgs, job: &Prepared) -> Result<()> {
             )
         })?;
     }
+    let first = &frames[0].file;
+    for file in std::iter::once(first).chain(&seq.animation) {
+        if let Some(dir) = file.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir)
+                .with_context(|| format!("cannot create the folder {}", dir.display()))?;
+        }
+        glint::export::check_output(file, args.scene.as_deref())?;
+    }
+    // Checked once the folders exist, so that links and `..` resolve.
     if let Some(animation) = &seq.animation
         && let Some(f) = frames.iter().find(|f| same_path(&f.file, animation))
     {
@@ -179,14 +188,6 @@ pub fn run(args: &RenderArgs, job: &Prepared) -> Result<()> {
             animation.display(),
             f.recorded.index
         );
-    }
-    let first = &frames[0].file;
-    for file in std::iter::once(first).chain(&seq.animation) {
-        if let Some(dir) = file.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir)
-                .with_context(|| format!("cannot create the folder {}", dir.display()))?;
-        }
-        glint::export::check_output(file, args.scene.as_deref())?;
     }
 
     let todo: Vec<&SequenceFrame> = frames.iter().filter(|f| !already_written(job, f)).collect();
@@ -273,15 +274,17 @@ pub fn run(args: &RenderArgs, job: &Prepared) -> Result<()> {
     Ok(())
 }
 
-/// Whether `a` and `b` name the same file (absolute, `.` and `..` taken
-/// out; through links where the file is already there).
+/// Whether `a` and `b` name the same file: their folders (which exist)
+/// resolved through links and `..`, then their names.
 fn same_path(a: &Path, b: &Path) -> bool {
-    let resolve = |p: &Path| {
-        std::fs::canonicalize(p)
-            .or_else(|_| std::path::absolute(p))
-            .map(|p| p.components().collect::<PathBuf>())
+    let resolve = |p: &Path| -> Option<PathBuf> {
+        let folder = match p.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        Some(std::fs::canonicalize(folder).ok()?.join(p.file_name()?))
     };
-    matches!((resolve(a), resolve(b)), (Ok(x), Ok(y)) if x == y)
+    matches!((resolve(a), resolve(b)), (Some(x), Some(y)) if x == y)
 }
 
 /// The sequence's cameras (with their time along the path) and its frame

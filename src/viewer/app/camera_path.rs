@@ -25,6 +25,8 @@ impl GlintApp {
         let now = ctx.input(|i| i.time);
         let edit = &mut self.edit;
         match command {
+            // Playing moves the camera: what it would record is the path.
+            PathCommand::ToggleRecording if self.path_player.is_playing() => {}
             PathCommand::ToggleRecording => {
                 self.path_player = if self.path_player.is_recording() {
                     PathPlayer::Idle
@@ -80,6 +82,15 @@ impl GlintApp {
         }
     }
 
+    /// Stops a playback, putting the camera back where it was (before a
+    /// save, which would otherwise write a camera half way along the path).
+    pub(super) fn stop_playing(&mut self) {
+        if let PathPlayer::Playing { camera_before, .. } = self.path_player {
+            self.edit.camera = camera_before;
+            self.path_player = PathPlayer::Idle;
+        }
+    }
+
     /// Once a frame: a recording keeps camera moves (at most one key every
     /// [`RECORD_INTERVAL`]); a playback moves the camera along the path
     /// and renders it as a drag does (previews), then puts it back.
@@ -111,6 +122,8 @@ impl GlintApp {
                 camera_before,
             } => {
                 let Some(path) = &self.edit.camera_path else {
+                    // The path was deleted (or undone) while playing.
+                    self.edit.camera = camera_before;
                     self.path_player = PathPlayer::Idle;
                     return;
                 };

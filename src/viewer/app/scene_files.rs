@@ -66,6 +66,7 @@ impl GlintApp {
     /// Writes the edits into the scene's TOML or NFF file; a scene without
     /// one (built in, an OBJ file) is saved as a new TOML file.
     pub fn save(&mut self) {
+        self.stop_playing();
         match self.edit.source.path() {
             Some(p) if save::saves_in_place(&self.edit.source) => {
                 let p = p.to_owned();
@@ -81,6 +82,7 @@ impl GlintApp {
     /// would choose (beside the scene, or where exports go), so another
     /// folder can be named.
     pub fn save_as(&mut self) {
+        self.stop_playing();
         if let Some(path) = save::choose_path(&self.edit.source) {
             if export::file_dialog_available() {
                 self.save_to(&path);
