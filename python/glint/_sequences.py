@@ -127,25 +127,30 @@ _WORKER_SCENES = {}
 def _worker_scene(source):
     """This worker's copy of the scene ``source`` describes: its name, its
     text and the keys the caller had edited."""
-    key = (source["name"], source["text"], tuple(sorted(source["edits"].items())))
+    key = (source["name"], source["text"], tuple(sorted(source["edits"].items())),
+           source.get("camera"))
     scene = _WORKER_SCENES.get(key)
     if scene is None:
         native = _glint.from_source(source["name"], source["text"])
         for k, v in source["edits"].items():
             if native.get(k) != v:
                 native.set(k, v)
+        if source.get("camera") is not None:
+            native.set_camera(source["camera"])
         _WORKER_SCENES.clear()
         _WORKER_SCENES[key] = scene = native
     return scene
 
 
-def _source(scene):
+def _source(scene, camera=False):
     """What a worker needs to load ``scene`` again: its name, its text,
-    and the value of every key (the camera aside: each frame brings its
-    own), which the worker sets where its copy differs: the edits."""
+    and the value of every key, which the worker sets where its copy
+    differs: the edits. The camera goes only with ``camera`` (each frame of
+    a sequence brings its own)."""
     name, text = scene._native.source()
     edits = {k: scene.get(k) for k in scene.keys() if not k.startswith("camera.")}
-    return {"name": name, "text": text, "edits": edits}
+    view = as_viewpoint(scene.camera)._native() if camera else None
+    return {"name": name, "text": text, "edits": edits, "camera": view}
 
 
 def _render_chunk(source, jobs, flags):
@@ -190,14 +195,16 @@ def render_frames(scene, cameras, width=None, height=None, *, out=None, client=N
     (``samples``, ``aa``, ``view``, ``octree``, ``max_depth``, ...).
 
     ``client``: a ``dask.distributed.Client`` or a scheduler's address
+    (a client made from an address is closed when the frames are done)
     runs every ``chunk`` frames as one Dask task; a worker lost mid-run
     has its tasks run again elsewhere, and each frame is yielded once. A
     scene the workers cannot load raises its :class:`SceneError` here,
-    once, and the remaining tasks are cancelled."""
+    once, and the remaining tasks are cancelled. The arguments, the
+    extra's presence and the scheduler are checked when called, before
+    the first frame is asked for."""
     if not (isinstance(chunk, int) and chunk >= 1):
         raise ValueError(f"chunk is how many frames a task renders, at least 1, got {chunk!r}")
     views = [as_viewpoint(c) for c in cameras]
-    count = len(views)
     flags = dict(render_flags, width=width, height=height)
     if out is not None:
         folder = _os.path.dirname(frame_file(out, 0))
@@ -210,20 +217,45 @@ def render_frames(scene, cameras, width=None, height=None, *, out=None, client=N
         return index, frame
 
     if client is None:
-        from ._frame import Frame
-        for index, view in enumerate(views):
-            native = scene._native.render(
-                camera=view._native(), frame=(index, count, view.time), **flags)
-            yield finished(index, Frame(native))
-        return
-
-    yield from _render_on_dask(scene, views, flags, _client(client), chunk, finished)
+        return _render_here(scene, views, flags, finished)
+    owned, client = isinstance(client, str), _client(client)
+    return _render_on_dask(scene, views, flags, (client, owned), chunk, finished)
 
 
-def _render_on_dask(scene, views, flags, client, chunk, finished):
-    from distributed import as_completed
+def _render_here(scene, views, flags, finished):
     from ._frame import Frame
 
+    count = len(views)
+    for index, view in enumerate(views):
+        native = scene._native.render(
+            camera=view._native(), frame=(index, count, view.time), **flags)
+        yield finished(index, Frame(native))
+
+
+def _completed(client, owned, futures):
+    """Each future's result as it completes; a scene error, sent back as
+    data, raised once; the futures left cancelled (and a client made here
+    closed) when the caller stops, fails or is done."""
+    from distributed import as_completed
+
+    try:
+        for future in as_completed(list(futures)):
+            kind, *payload = future.result()
+            if kind == "scene-error":
+                _raise_scene_error(*payload)
+            yield future, payload[0]
+    finally:
+        for f in futures:
+            if not f.done():
+                f.cancel()
+        if owned:
+            client.close()
+
+
+def _render_on_dask(scene, views, flags, client_owned, chunk, finished):
+    from ._frame import Frame
+
+    client, owned = client_owned
     count = len(views)
     task_flags = {k: v for k, v in flags.items() if k not in ("cancel",)}
     # The scene travels once to every worker; tasks name it. (In a list:
@@ -237,24 +269,16 @@ def _render_on_dask(scene, views, flags, client, chunk, finished):
     ]
     parts_flags = {k: v for k, v in flags.items() if k not in ("threads", "stats", "cancel")}
     seen = set()
-    try:
-        for future in as_completed(futures):
-            kind, *payload = future.result()
-            if kind == "scene-error":
-                _raise_scene_error(*payload)
-            for index, (header, pixels) in payload[0]:
-                if index in seen:
-                    continue
-                seen.add(index)
-                view = views[index]
-                native = scene._native.frame_from_parts(
-                    header, pixels, camera=view._native(),
-                    frame=(index, count, view.time), **parts_flags)
-                yield finished(index, Frame(native))
-    finally:
-        for f in futures:
-            if not f.done():
-                f.cancel()
+    for _, frames in _completed(client, owned, futures):
+        for index, (header, pixels) in frames:
+            if index in seen:
+                continue
+            seen.add(index)
+            view = views[index]
+            native = scene._native.frame_from_parts(
+                header, pixels, camera=view._native(),
+                frame=(index, count, view.time), **parts_flags)
+            yield finished(index, Frame(native))
 
 
 def _bench_task(source, setting, options):
@@ -274,36 +298,38 @@ def sweep(scenes, settings, *, client=None, **bench_options):
     ``memory_budget_mib``): one task per (scene, setting), here or on
     Dask. Yields ``(scene_index, setting_index, record)`` as each
     finishes, ``record`` being :meth:`Scene.bench`'s with
-    ``octree_only=True``; ``bench_options`` are that method's."""
-    import json as _json
-
+    ``octree_only=True`` (from the scene's camera as edited);
+    ``bench_options`` are that method's."""
     scenes = list(scenes)
     settings = [dict(s) for s in settings]
     pairs = list(_itertools.product(range(len(scenes)), range(len(settings))))
-    sources = [_source(s) for s in scenes]
+    # A benchmark renders from the scene's own camera: it travels too.
+    sources = [_source(s, camera=True) for s in scenes]
     if client is None:
-        for i, j in pairs:
-            kind, *payload = _bench_task(sources[i], settings[j], bench_options)
-            if kind == "scene-error":
-                _raise_scene_error(*payload)
-            yield i, j, _json.loads(payload[0])
-        return
-    from distributed import as_completed
+        return _sweep_here(sources, settings, pairs, bench_options)
+    owned, client = isinstance(client, str), _client(client)
+    return _sweep_on_dask(sources, settings, pairs, bench_options, (client, owned))
 
-    client = _client(client)
+
+def _sweep_here(sources, settings, pairs, options):
+    import json as _json
+
+    for i, j in pairs:
+        kind, *payload = _bench_task(sources[i], settings[j], options)
+        if kind == "scene-error":
+            _raise_scene_error(*payload)
+        yield i, j, _json.loads(payload[0])
+
+
+def _sweep_on_dask(sources, settings, pairs, options, client_owned):
+    import json as _json
+
+    client, owned = client_owned
     scattered = client.scatter(sources, broadcast=True, hash=False)
     futures = {
-        client.submit(_bench_task, scattered[i], settings[j], bench_options, pure=False): (i, j)
+        client.submit(_bench_task, scattered[i], settings[j], options, pure=False): (i, j)
         for i, j in pairs
     }
-    try:
-        for future in as_completed(list(futures)):
-            kind, *payload = future.result()
-            if kind == "scene-error":
-                _raise_scene_error(*payload)
-            i, j = futures[future]
-            yield i, j, _json.loads(payload[0])
-    finally:
-        for f in futures:
-            if not f.done():
-                f.cancel()
+    for future, record in _completed(client, owned, futures):
+        i, j = futures[future]
+        yield i, j, _json.loads(record)

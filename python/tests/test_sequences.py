@@ -65,6 +65,25 @@ def test_client_without_dask_says_how_to_install_it(monkeypatch):
         list(glint.render_frames(scene, scene.turntable(2), client="tcp://127.0.0.1:9", **SIZE))
 
 
+def test_a_sweep_times_the_scene_from_its_edited_camera():
+    scene = glint.load(scene_path("sphere.toml"))
+    options = dict(width=16, height=12, repeat=1)
+    before = next(glint.sweep([scene], [{"max_depth": 4}], **options))[2]["rays"]
+    scene.camera = scene.turntable(4)[0]._replace(fov=5)
+    after = next(glint.sweep([scene], [{"max_depth": 4}], **options))[2]["rays"]
+    direct = scene.bench(octree_only=True, **options)["rays"]
+    assert after == direct
+    assert after["primary_hits"] != before["primary_hits"], "a narrower view hits more"
+
+
+def test_arguments_are_checked_when_called_not_at_the_first_frame():
+    scene = glint.load(scene_path("sphere.toml"))
+    with pytest.raises(ValueError, match="chunk"):
+        glint.render_frames(scene, scene.turntable(2), chunk=0)
+    with pytest.raises(TypeError, match="a camera is"):
+        glint.render_frames(scene, [{"eye": (0, 0, 1)}])
+
+
 def test_frame_files_follow_the_command_lines_names():
     assert glint.frame_file("frames/turn_####.png", 7) == "frames/turn_0007.png"
     assert glint.frame_file("out/fly.png", 12) == "out/fly_0012.png"
