@@ -114,6 +114,9 @@ pub(super) fn mesh_materials(
     };
     let mut default = None;
     let mut slots = Vec::with_capacity(mesh.material_names.len());
+    // Notes many materials share ("Ns -1.96 used as no highlight" for 17
+    // of them) are said once, naming the materials.
+    let mut grouped: std::collections::BTreeMap<String, Vec<String>> = Default::default();
     let used: Vec<bool> = {
         let mut used = vec![false; mesh.material_names.len()];
         for &m in &mesh.triangle_materials {
@@ -132,14 +135,29 @@ pub(super) fn mesh_materials(
                 }
                 let clamped = e.clamped();
                 if !clamped.is_empty() {
-                    scene.load_notes.push(format!(
-                        "{}: material `{}` brought within glint's limits: {}",
-                        mesh_path.display(),
-                        e.name,
-                        clamped.join(", ")
-                    ));
+                    grouped
+                        .entry(format!(
+                            "brought within glint's limits: {}",
+                            clamped.join(", ")
+                        ))
+                        .or_default()
+                        .push(e.name.clone());
                 }
-                add(scene, e.to_material(e.name.clone()))
+                let material = e.to_material(e.name.clone());
+                // `d 0` on a surface that does not refract: a ghost (glass,
+                // `illum 6` or `7`, is meant to be see-through).
+                let refracts = matches!(e.illum, Some(6 | 7));
+                if e.opacity().0 <= 0.0 && !refracts {
+                    grouped
+                        .entry(
+                            "fully transparent (`d 0`): its faces show only their \
+                             highlights and reflections"
+                                .into(),
+                        )
+                        .or_default()
+                        .push(e.name.clone());
+                }
+                add(scene, material)
             }
             _ if !used[slot] => u32::MAX,
             _ => {
@@ -162,6 +180,17 @@ pub(super) fn mesh_materials(
             }
         };
         slots.push(index);
+    }
+    for (note, names) in grouped {
+        let named = names
+            .iter()
+            .map(|n| format!("`{n}`"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        scene.load_notes.push(match names.len() {
+            1 => format!("{}: material {named} {note}", mesh_path.display()),
+            n => format!("{}: {n} materials ({named}) {note}", mesh_path.display()),
+        });
     }
     (slots, default)
 }

@@ -116,18 +116,29 @@ fn parse_into(
     );
     scene.color_values = ColorConvention::Display;
     let mut material: Option<u32> = None;
+    let mut default_material: Option<u32> = None;
+    // NFF materials are named by their `f`'s order: f1, f2, ...
+    let mut f_materials = 0;
 
     while let Some(t) = tokens.advance() {
         let (keyword, line, column) = (t.text, t.line, t.column);
         tokens.entity = (line, column, keyword);
-        let needs_material = |m: Option<u32>, tokens: &Tokens| {
-            m.ok_or_else(|| {
-                tokens.error_at(
-                    line,
-                    column,
-                    keyword,
-                    "an object comes before any `f` material",
-                )
+        // NFF gives each object the last `f` before it; objects before any
+        // (as course files write them) get a default grey, said once.
+        let mut needs_material = |m: Option<u32>, scene: &mut Scene| -> u32 {
+            m.unwrap_or_else(|| {
+                *default_material.get_or_insert_with(|| {
+                    scene.materials.push(Material {
+                        name: "default".into(),
+                        ..Material::default()
+                    });
+                    scene.load_notes.push(format!(
+                        "{}:{line}:{column}: `{keyword}` comes before any `f` material: the \
+                         objects before the first `f` use a default grey",
+                        path.display()
+                    ));
+                    scene.materials.len() as u32 - 1
+                })
             })
         };
         match keyword {
@@ -260,7 +271,7 @@ fn parse_into(
                     1.0
                 };
                 let m = Material {
-                    name: format!("f{}", scene.materials.len() + 1),
+                    name: format!("f{}", f_materials + 1),
                     color,
                     ka: kd,
                     kd,
@@ -279,6 +290,7 @@ fn parse_into(
                     Some(i) => i,
                     None => {
                         scene.materials.push(m);
+                        f_materials += 1;
                         scene.materials.len() - 1
                     }
                 };
@@ -291,7 +303,7 @@ fn parse_into(
             "s" => {
                 let center = tokens.vec3("sphere centre")?;
                 let radius = tokens.number("sphere radius")?.abs();
-                let m = needs_material(material, &tokens)?;
+                let m = needs_material(material, &mut scene);
                 if radius == 0.0 {
                     return Err(tokens.error_at(
                         line,
@@ -307,7 +319,7 @@ fn parse_into(
                 let base_radius = tokens.number("cone base radius")?;
                 let apex = tokens.vec3("cone apex")?;
                 let apex_radius = tokens.number("cone apex radius")?;
-                let m = needs_material(material, &tokens)?;
+                let m = needs_material(material, &mut scene);
                 // Like a sphere of radius zero: a segment, with no surface.
                 if base_radius == 0.0 && apex_radius == 0.0 {
                     return Err(tokens.error_at(
@@ -341,7 +353,7 @@ fn parse_into(
                         normals.push(tokens.vec3("vertex normal")?);
                     }
                 }
-                let m = needs_material(material, &tokens)?;
+                let m = needs_material(material, &mut scene);
                 let normals: Vec<DVec3> = normals.iter().map(|v| v.normalize_or_zero()).collect();
                 // Concave outlines are common (gear faces): ear clipping, not a fan.
                 scene.push_polygon(&vertices, with_normals.then_some(&normals[..]), m);
@@ -609,11 +621,23 @@ pp 3
             message.contains("t.nff:1:1: `v`: file ends at line 2 while reading its `at` line"),
             "{message}"
         );
+        // An object before any `f` gets a default grey, with a note.
+        let early = parse_str(
+            "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 45\nhither 1\n\
+             resolution 8 8\ns 0 0 0 1\nf 1 0 0 1 0 0 0 0\ns 2 0 0 1\n",
+        )
+        .unwrap();
+        assert_eq!(early.shapes.len(), 2);
+        assert_eq!(early.materials[0].name, "default");
+        assert_eq!(early.materials[1].name, "f1");
+        assert_eq!(*early.shape_materials, [0, 1]);
         assert!(
-            parse_str("s 0 0 0 1\n")
-                .unwrap_err()
-                .to_string()
-                .contains("before any `f`")
+            early
+                .load_notes
+                .iter()
+                .any(|n| n.contains("t.nff:8:1: `s` comes before any `f`")),
+            "{:?}",
+            early.load_notes
         );
         assert!(
             parse_str("b 0 0 0\n")

@@ -786,3 +786,45 @@ fn a_bridged_polygon_with_a_hole_renders_as_its_ring() {
     let (differ, _) = common::diff(&keyhole, &quads, 0);
     assert_eq!(differ, 0, "the keyhole face renders as the four quads");
 }
+
+/// Notes many materials share are said once, naming them (a file with
+/// `Ns -1.96` in 17 materials had 17 notes), and a material with `d 0`
+/// on a surface that does not refract is named: its faces show only
+/// their highlights, which looks like a ghost with nothing said. Glass
+/// (`illum 7`) is meant to be see-through and is not named.
+#[test]
+fn shared_material_notes_are_grouped_and_ghosts_named() {
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "many.obj",
+        b"mtllib many.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
+          usemtl a\nf 1 2 3\nusemtl b\nf 1 3 4\nusemtl c\nf 2 3 4\n\
+          usemtl ghost\nf 1 2 4\nusemtl glass\nf 4 3 1\n",
+    );
+    write(
+        dir.path(),
+        "many.mtl",
+        b"newmtl a\nNs -1.96\nnewmtl b\nNs -1.96\nnewmtl c\nNs -1.96\n\
+          newmtl ghost\nKd 0.5 0.5 0.5\nd 0\n\
+          newmtl glass\nillum 7\nd 0\nNi 1.5\n",
+    );
+    let toml = dir.path().join("scene.toml");
+    std::fs::write(&toml, facing_scene("many.obj", "")).unwrap();
+    let notes = load_file(&toml).load_notes;
+    let highlight: Vec<_> = notes.iter().filter(|n| n.contains("Ns -1.96")).collect();
+    assert_eq!(highlight.len(), 1, "{notes:?}");
+    assert!(
+        highlight[0].contains("3 materials (`a`, `b`, `c`)"),
+        "{notes:?}"
+    );
+    let ghosts: Vec<_> = notes
+        .iter()
+        .filter(|n| n.contains("fully transparent"))
+        .collect();
+    assert_eq!(ghosts.len(), 1, "{notes:?}");
+    assert!(
+        ghosts[0].contains("material `ghost`") && !ghosts[0].contains("glass"),
+        "{notes:?}"
+    );
+}

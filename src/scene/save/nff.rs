@@ -131,6 +131,13 @@ pub fn scene_nff(request: &SaveRequest) -> Result<SavedText, SaveError> {
         if old == new {
             continue;
         }
+        // The default grey of objects before any `f` has no line to edit.
+        if layout.materials.get(i).is_none_or(Vec::is_empty) {
+            left_out.push(LeftOut::Material {
+                name: old.name.clone(),
+            });
+            continue;
+        }
         // NFF has one coefficient for the highlight and the mirror ray, and
         // weights the ambient term by Kd.
         if new.reflectivity != new.ks {
