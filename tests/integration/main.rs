@@ -14,6 +14,7 @@ mod extremes;
 mod inspect;
 mod module_graph;
 mod obj_content;
+mod obj_materials;
 mod octree_identity;
 mod render_scenes;
 mod robust_scenes;
