@@ -17,14 +17,18 @@ const CANDIDATES: usize = 16;
 /// face is not one (no `a b … b a` bridge) or no bridge splits it.
 pub fn triangulate_keyhole(ids: &[u32], points: &[DVec3]) -> Option<Vec<[u32; 3]>> {
     let n = ids.len();
-    // The bridge: `a` at i and j, its neighbour `b` after i and before j.
+    // The bridge: `a` at i and j, its neighbour `b` after i and before j,
+    // read round the face's cycle: the list may start anywhere on it (`1 2
+    // 3 4 1 5 6 7 8 5` is the ring 1 2 3 4 with the bridge 1-5 to the hole
+    // 5 6 7 8, the closing edge back to the first 1 being the bridge out).
+    let at = |k: usize| ids[k % n];
     let (i, j) = (0..n).find_map(|i| {
-        let j = (i + 1..n).find(|&j| ids[j] == ids[i])?;
-        (j >= i + 5 && ids[i + 1] == ids[j - 1] && ids[i + 1] != ids[i]).then_some((i, j))
+        let j = (i + 1..i + n).find(|&j| at(j) == ids[i])?;
+        (j >= i + 5 && at(i + 1) == at(j - 1) && at(i + 1) != ids[i]).then_some((i, j))
     })?;
     // Positions in `ids` of the inner loop (b first) and the outer (a first).
-    let inner: Vec<usize> = (i + 1..j - 1).collect();
-    let outer: Vec<usize> = (j..n).chain(0..i).collect();
+    let inner: Vec<usize> = (i + 1..j - 1).map(|k| k % n).collect();
+    let outer: Vec<usize> = (j..i + n).map(|k| k % n).collect();
     let distinct = |loop_: &[usize]| {
         let mut seen: Vec<u32> = loop_.iter().map(|&k| ids[k]).collect();
         seen.sort_unstable();
@@ -111,6 +115,19 @@ mod tests {
         let ids = [0u32, 4, 5, 6, 7, 4, 0, 1, 2, 3];
         let corners: Vec<DVec3> = ids.iter().map(|&k| points[k as usize]).collect();
         let triangles = triangulate_keyhole(&ids, &corners).expect("a keyhole");
+        let covered: f64 = triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|k| corners[k as usize]);
+                0.5 * (b - a).cross(c - a).z.abs()
+            })
+            .sum();
+        assert!((covered - 12.0).abs() < 1e-12, "covered {covered}");
+        // The same ring written from the outer loop first, its bridge out
+        // being the closing edge: 0 1 2 3 0 4 5 6 7 4.
+        let ids = [0u32, 1, 2, 3, 0, 4, 5, 6, 7, 4];
+        let corners: Vec<DVec3> = ids.iter().map(|&k| points[k as usize]).collect();
+        let triangles = triangulate_keyhole(&ids, &corners).expect("a keyhole round the end");
         let covered: f64 = triangles
             .iter()
             .map(|t| {

@@ -694,4 +694,20 @@ fn a_bridged_polygon_with_a_hole_renders_as_its_ring() {
     }
     let (differ, _) = common::diff(&keyhole, &quads, 0);
     assert_eq!(differ, 0, "the keyhole face renders as the four quads");
+    // Written from the outer loop, the bridge back being the closing edge
+    // (`1 2 3 4 1 5 ... 5`): the same ring, not a wedge cut out of it.
+    write(
+        dir.path(),
+        "outer_first.obj",
+        format!(
+            "{vertices}f 1 2 3 4 1 5 8 7 6 5
+"
+        )
+        .as_bytes(),
+    );
+    let (differ, _) = common::diff(&image("outer_first.obj"), &quads, 0);
+    assert_eq!(
+        differ, 0,
+        "the outer-first keyhole renders as the four quads"
+    );
 }
