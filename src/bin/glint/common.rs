@@ -69,6 +69,46 @@ impl AccelArg {
 pub use glint::report::median;
 
 /// Loads a scene and reports how long it took.
+/// The progress bar on the terminal, if one is shown: the Ctrl+C handler
+/// silences it before ending its line, so no redraw from a render thread
+/// lands after that line end.
+static TERMINAL_BAR: std::sync::Mutex<Option<indicatif::ProgressBar>> =
+    std::sync::Mutex::new(None);
+
+/// A progress bar of `len` steps drawn with `template`, when stderr is a
+/// terminal; `None` otherwise (a log or a pipe gets no redraws).
+pub fn terminal_bar(len: u64, template: &str) -> Option<indicatif::ProgressBar> {
+    use std::io::IsTerminal;
+    if !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = indicatif::ProgressBar::new(len);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(template)
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    if let Ok(mut shown) = TERMINAL_BAR.lock() {
+        *shown = Some(bar.clone());
+    }
+    Some(bar)
+}
+
+/// Stops the shown progress bar drawing and ends its line (on a terminal),
+/// so the shell's prompt starts on a line of its own after Ctrl+C.
+pub fn end_terminal_line() {
+    use std::io::IsTerminal;
+    // `try_lock`: the handler must not wait on a thread it interrupts.
+    if let Ok(mut shown) = TERMINAL_BAR.try_lock()
+        && let Some(bar) = shown.take()
+    {
+        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+    }
+    if std::io::stderr().is_terminal() {
+        say!("");
+    }
+}
+
 pub fn load_scene(path: &Path) -> Result<(Scene, f64)> {
     let start = Instant::now();
     let scene = glint::scene::load(path)?;

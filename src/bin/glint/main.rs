@@ -89,11 +89,7 @@ fn main() -> std::process::ExitCode {
     // unusual platform) the signal's default stands.
     let _ = ctrlc::set_handler(|| {
         glint::export::remove_unfinished_outputs();
-        // The progress bar's line is still open: end it, so the shell's
-        // prompt starts on a line of its own.
-        if std::io::IsTerminal::is_terminal(&std::io::stderr()) {
-            say!("");
-        }
+        common::end_terminal_line();
         std::process::exit(130);
     });
     let cli = Cli::parse_from(with_default_command(std::env::args_os().collect()));

@@ -335,17 +335,10 @@ fn render(job: &Prepared, count_work: bool) -> Result<(RenderedFrame, f64)> {
     let renderer = job
         .renderer(job.settings)
         .with_context(|| format!("cannot render {}", job.scene_name))?;
-    let bar = std::io::stderr().is_terminal().then(|| {
-        let bar = indicatif::ProgressBar::new(1);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{spinner} rendering [{bar:40}] {percent}% {elapsed} (eta {eta})",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
-            .progress_chars("=> "),
-        );
-        bar
-    });
+    let bar = crate::common::terminal_bar(
+        1,
+        "{spinner} rendering [{bar:40}] {percent}% {elapsed} (eta {eta})",
+    );
     let watch = ProgressBar { bar: bar.as_ref() };
     let options = PassOptions {
         count_work,

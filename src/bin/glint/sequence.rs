@@ -3,7 +3,6 @@
 //! frames already written with the same record are kept, so an interrupted
 //! run picks up where it stopped; `--animation` adds an animated PNG.
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -199,17 +198,14 @@ pub fn run(args: &RenderArgs, job: &Prepared) -> Result<()> {
             todo.len()
         );
     }
-    let bar = (std::io::stderr().is_terminal() && !todo.is_empty()).then(|| {
-        let bar = indicatif::ProgressBar::new(todo.len() as u64);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{spinner} frame {msg} [{bar:30}] {pos}/{len} frames, {elapsed} (eta {eta})",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
-            .progress_chars("=> "),
-        );
-        bar
-    });
+    let bar = if todo.is_empty() {
+        None
+    } else {
+        crate::common::terminal_bar(
+            todo.len() as u64,
+            "{spinner} frame {msg} [{bar:30}] {pos}/{len} frames, {elapsed} (eta {eta})",
+        )
+    };
     let start = Instant::now();
     for f in &todo {
         if let Some(b) = &bar {
