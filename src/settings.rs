@@ -141,6 +141,11 @@ pub enum Accel {
 impl Accel {
     pub const ALL: [Accel; 3] = [Accel::Octree, Accel::Bvh, Accel::BruteForce];
 
+    /// What `--octree on|off` (and a scene's `octree.enabled`) chooses.
+    pub fn from_octree_switch(on: bool) -> Self {
+        if on { Accel::Octree } else { Accel::BruteForce }
+    }
+
     /// As `--accel` and the statistics name it.
     pub fn name(self) -> &'static str {
         match self {
@@ -151,9 +156,20 @@ impl Accel {
     }
 }
 
+impl std::str::FromStr for Accel {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|a| a.name() == s)
+            .ok_or_else(|| format!("unknown accelerator `{s}` (expected octree, bvh or none)"))
+    }
+}
+
 /// Everything that decides the image besides the scene; the command line
 /// and the viewer override the scene's own values.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(from = "RecordedSettings", into = "RecordedSettings")]
 pub struct RenderSettings {
     pub width: u32,
     pub height: u32,
@@ -161,33 +177,90 @@ pub struct RenderSettings {
     /// which shoots the pixel corners).
     pub samples: u32,
     pub max_depth: u32,
-    pub use_octree: bool,
+    /// What ray queries go through.
+    pub accel: Accel,
     pub view: ViewMode,
-    /// Records written before these settings existed were rendered with
-    /// their defaults.
-    #[serde(default)]
     pub protocol: Protocol,
-    #[serde(default)]
     pub colors: ColorConvention,
-    #[serde(default)]
     pub sides: Sides,
     /// With `samples > 1`: trace every pixel's centre, then the full grid
     /// only where the picture shows an edge (see [`crate::render::adaptive`]).
-    #[serde(default)]
     pub adaptive: bool,
     /// Cast shadow rays (off only in the viewer's previews while moving:
     /// every light then reaches every point that faces it).
-    #[serde(default = "yes", skip_serializing_if = "Clone::clone")]
     pub shadows: bool,
-    /// Ray queries through a BVH ([`Accel::Bvh`]; `use_octree` is then
-    /// false). Set both through [`RenderSettings::set_accel`]. Absent from
-    /// records when false, as in those from before it.
+}
+
+/// [`RenderSettings`] as PNG records and JSON write them: the accelerator
+/// as `use_octree` and `bvh` (absent when false), the fields records held
+/// before the BVH existed; fields added since default to what renders
+/// made before them used.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct RecordedSettings {
+    width: u32,
+    height: u32,
+    samples: u32,
+    max_depth: u32,
+    use_octree: bool,
+    view: ViewMode,
+    #[serde(default)]
+    protocol: Protocol,
+    #[serde(default)]
+    colors: ColorConvention,
+    #[serde(default)]
+    sides: Sides,
+    #[serde(default)]
+    adaptive: bool,
+    #[serde(default = "yes", skip_serializing_if = "Clone::clone")]
+    shadows: bool,
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    pub bvh: bool,
+    bvh: bool,
 }
 
 fn yes() -> bool {
     true
+}
+
+impl From<RecordedSettings> for RenderSettings {
+    fn from(r: RecordedSettings) -> Self {
+        let accel = if r.bvh {
+            Accel::Bvh
+        } else {
+            Accel::from_octree_switch(r.use_octree)
+        };
+        Self {
+            width: r.width,
+            height: r.height,
+            samples: r.samples,
+            max_depth: r.max_depth,
+            accel,
+            view: r.view,
+            protocol: r.protocol,
+            colors: r.colors,
+            sides: r.sides,
+            adaptive: r.adaptive,
+            shadows: r.shadows,
+        }
+    }
+}
+
+impl From<RenderSettings> for RecordedSettings {
+    fn from(s: RenderSettings) -> Self {
+        Self {
+            width: s.width,
+            height: s.height,
+            samples: s.samples,
+            max_depth: s.max_depth,
+            use_octree: s.accel == Accel::Octree,
+            view: s.view,
+            protocol: s.protocol,
+            colors: s.colors,
+            sides: s.sides,
+            adaptive: s.adaptive,
+            shadows: s.shadows,
+            bvh: s.accel == Accel::Bvh,
+        }
+    }
 }
 
 impl RenderSettings {
@@ -196,21 +269,6 @@ impl RenderSettings {
         crate::limits::check_image_size(self.width, self.height)?;
         crate::limits::check_samples(self.samples)?;
         crate::limits::check_max_depth(self.max_depth)
-    }
-
-    /// What these settings' ray queries go through.
-    pub fn accel(&self) -> Accel {
-        match (self.bvh, self.use_octree) {
-            (true, _) => Accel::Bvh,
-            (false, true) => Accel::Octree,
-            (false, false) => Accel::BruteForce,
-        }
-    }
-
-    /// Sets what ray queries go through (`use_octree` and `bvh` together).
-    pub fn set_accel(&mut self, accel: Accel) {
-        self.use_octree = accel == Accel::Octree;
-        self.bvh = accel == Accel::Bvh;
     }
 
     /// The anti-aliasing these settings ask for.
@@ -354,8 +412,8 @@ pub struct Overrides {
     pub height: Option<u32>,
     pub anti_aliasing: Option<AntiAliasing>,
     pub max_depth: Option<u32>,
-    /// The octree on or off (`--octree`); [`Overrides::accel`] wins.
-    pub use_octree: Option<bool>,
+    /// What ray queries go through (`--accel`, or `--octree on|off`
+    /// as [`Accel::from_octree_switch`] reads it).
     pub accel: Option<Accel>,
     pub octree: OctreeOverrides,
     pub view: Option<ViewMode>,
@@ -413,11 +471,8 @@ impl Overrides {
         if let Some(d) = self.max_depth {
             settings.max_depth = d;
         }
-        if let Some(o) = self.use_octree {
-            settings.set_accel(if o { Accel::Octree } else { Accel::BruteForce });
-        }
         if let Some(a) = self.accel {
-            settings.set_accel(a);
+            settings.accel = a;
         }
         self.octree.apply(params);
         if let Some(v) = self.view {
@@ -445,46 +500,40 @@ mod tests {
             height: 48,
             samples: 1,
             max_depth: 7,
-            use_octree: true,
+            accel: Accel::Octree,
             view: ViewMode::Shaded,
             protocol: Protocol::Glint,
             colors: ColorConvention::Linear,
             sides: Sides::Two,
             adaptive: false,
             shadows: true,
-            bvh: false,
         }
     }
 
     #[test]
-    fn the_accelerator_is_one_of_three_whichever_override_sets_it() {
-        let mut settings = base();
-        assert_eq!(settings.accel(), Accel::Octree);
-        let mut params = OctreeParams::default();
+    fn each_accelerator_is_recorded_as_records_always_wrote_it_and_reads_back() {
+        let fields = |accel| {
+            let json = serde_json::to_value(RenderSettings { accel, ..base() }).unwrap();
+            (json["use_octree"].as_bool(), json.get("bvh").cloned())
+        };
+        assert_eq!(
+            fields(Accel::Octree),
+            (Some(true), None),
+            "bvh absent when false"
+        );
+        assert_eq!(fields(Accel::BruteForce), (Some(false), None));
+        assert_eq!(fields(Accel::Bvh), (Some(false), Some(true.into())));
         for accel in Accel::ALL {
-            settings.set_accel(accel);
-            assert_eq!(settings.accel(), accel);
-            assert_eq!(settings.use_octree, accel == Accel::Octree);
-            // `--octree on|off` over a BVH render replaces it.
-            for on in [true, false] {
-                let mut s = settings;
-                Overrides {
-                    use_octree: Some(on),
-                    ..Overrides::default()
-                }
-                .apply(&mut s, &mut params);
-                assert_eq!(
-                    s.accel(),
-                    if on { Accel::Octree } else { Accel::BruteForce }
-                );
-            }
+            let settings = RenderSettings { accel, ..base() };
+            let json = serde_json::to_string(&settings).unwrap();
+            let read: RenderSettings = serde_json::from_str(&json).unwrap();
+            assert_eq!(read, settings);
         }
-        // Records from before the BVH read as they were written.
-        let mut old = serde_json::to_value(base()).unwrap();
-        assert!(old.get("bvh").is_none(), "absent when false");
-        old["use_octree"] = false.into();
-        let read: RenderSettings = serde_json::from_value(old).unwrap();
-        assert_eq!(read.accel(), Accel::BruteForce);
+        // A record from before protocols, sides, adaptive and shadows.
+        let old = r#"{"width":8,"height":6,"samples":1,"max_depth":5,"use_octree":false,"view":"shaded"}"#;
+        let read: RenderSettings = serde_json::from_str(old).unwrap();
+        assert_eq!(read.accel, Accel::BruteForce);
+        assert!(read.shadows && !read.adaptive);
     }
 
     #[test]

@@ -160,6 +160,7 @@ class Scene:
         samples=None,
         aa=None,
         octree=None,
+        accel=None,
         max_depth=None,
         view=None,
         threads=None,
@@ -175,7 +176,10 @@ class Scene:
         settings, as ``glint render``'s flags do: ``samples`` 1 or 16 or
         ``aa`` ``"off"``, ``"adaptive"``, ``"full"``; ``view`` ``"shaded"``,
         ``"normals"``, ``"depth"``, ``"cost"``, ``"cost-steps"``,
-        ``"aa-need"``; ``threads`` (default one per core). ``stats=True``
+        ``"aa-need"``; ``accel`` ``"octree"``, ``"bvh"`` or ``"none"``
+        (what ray queries go through, as ``--accel``: the same image in
+        another time; ``octree=False`` is ``"none"``); ``threads`` (default
+        one per core). ``stats=True``
         counts the work per ray, as ``--stats`` does (the same image, in
         more time) and fills ``frame.stats``. ``cancel``, an object with
         ``is_set()`` such as ``threading.Event``, stops the render with
@@ -189,6 +193,7 @@ class Scene:
             samples=samples,
             aa=aa,
             octree=octree,
+            accel=accel,
             max_depth=max_depth,
             view=view,
             threads=threads,
@@ -205,7 +210,7 @@ class Scene:
     def trace_pixel(self, x, y, **settings):
         """The tree of rays pixel (x, y)'s centre ray spawns, each with its
         octree walk, as nested dicts: ``glint render --trace-pixel X,Y``'s
-        JSON. Takes ``width``, ``height``, ``octree``, ``max_depth``,
+        JSON. Takes ``width``, ``height``, ``octree``, ``accel``, ``max_depth``,
         ``protocol``, ``colors``, ``sides`` as :meth:`render` does."""
         return _json.loads(self._native.trace_pixel(x, y, **settings))
 

@@ -192,7 +192,7 @@ def render_frames(scene, cameras, width=None, height=None, *, out=None, client=N
     as ``"frames/f_####.png"``, numbered as ``glint render -o``), each
     frame is written there, by this process, through a temporary file, as
     soon as it arrives. ``render_flags`` are :meth:`Scene.render`'s
-    (``samples``, ``aa``, ``view``, ``octree``, ``max_depth``, ...).
+    (``samples``, ``aa``, ``view``, ``accel``, ``max_depth``, ...).
 
     ``client``: a ``dask.distributed.Client`` or a scheduler's address
     (a client made from an address is closed when the frames are done)

@@ -6,7 +6,7 @@ use pyo3::prelude::*;
 
 use glint::limits::MAX_THREADS_PER_CORE;
 use glint::scene::Scene;
-use glint::settings::{AntiAliasing, Overrides, Protocol, RenderSettings};
+use glint::settings::{Accel, AntiAliasing, Overrides, Protocol, RenderSettings};
 
 /// What a call asks for instead of the scene's own settings (`None`
 /// keeps the scene's), as `glint render`'s flags do.
@@ -17,6 +17,8 @@ pub struct RenderOptions<'a> {
     pub samples: Option<u32>,
     pub aa: Option<&'a str>,
     pub octree: Option<bool>,
+    /// `octree`, `bvh` or `none`, as `--accel` names them.
+    pub accel: Option<&'a str>,
     pub max_depth: Option<u32>,
     pub view: Option<&'a str>,
     pub protocol: Option<&'a str>,
@@ -49,6 +51,25 @@ fn parsed<T: std::str::FromStr<Err = String>>(text: Option<&str>) -> PyResult<Op
 }
 
 impl RenderOptions<'_> {
+    /// What ray queries go through: `accel`, or `octree` as `--octree
+    /// on|off` reads it; both only when they agree (as on the command line).
+    fn accel(&self) -> PyResult<Option<Accel>> {
+        let named: Option<Accel> = parsed(self.accel)?;
+        let switched = self.octree.map(Accel::from_octree_switch);
+        match (named, switched) {
+            (Some(a), Some(s)) if a != s => Err(PyValueError::new_err(format!(
+                "octree={} and accel='{}' disagree: give one",
+                if self.octree == Some(true) {
+                    "True"
+                } else {
+                    "False"
+                },
+                a.name()
+            ))),
+            (a, s) => Ok(a.or(s)),
+        }
+    }
+
     /// The scene's settings with these applied, checked against the limits.
     pub fn settings(&self, scene: &Scene) -> PyResult<RenderSettings> {
         let anti_aliasing = match (self.samples, self.aa) {
@@ -85,7 +106,7 @@ impl RenderOptions<'_> {
             height: self.height,
             anti_aliasing,
             max_depth: self.max_depth,
-            use_octree: self.octree,
+            accel: self.accel()?,
             view: parsed(self.view)?,
             protocol,
             colors: parsed(self.colors)?,

@@ -15,6 +15,7 @@ use glint::export::SceneEdits;
 use glint::render::{PassInfo, PassOptions, PassWatch, Renderer};
 use glint::report::{RenderStats, RenderTimes, TraceReport};
 use glint::scene::{KeyValue, Scene};
+use glint::settings::{Accel, RenderSettings};
 
 use crate::errors::{edit_error, octree_error, render_error};
 use crate::frame::{FrameHeader, PyFrame};
@@ -139,6 +140,68 @@ fn snapshot(slf: &Bound<'_, PyScene>) -> Snapshot {
         load_s: me.load_s,
         edits: me.edits(),
         cached: me.octree.clone(),
+    }
+}
+
+/// What a render's ray queries go through, built as `glint render` builds
+/// it: the octree (kept between renders), the BVH when `accel='bvh'`, and
+/// the light buffer shadow rays ask first (not for a counted render: it
+/// would hide the accelerator's work).
+struct Queries {
+    tree: Arc<Octree>,
+    bvh: Option<glint::accel::Bvh>,
+    light_buffer: Option<glint::accel::LightBuffer>,
+    build_s: f64,
+}
+
+impl Queries {
+    fn build(
+        slf: &Bound<'_, PyScene>,
+        snap: &Snapshot,
+        settings: &RenderSettings,
+        pool: &rayon::ThreadPool,
+        counted: bool,
+    ) -> PyResult<Self> {
+        let (tree, mut build_s) = octree_for(slf, snap, settings.accel == Accel::Octree, pool)?;
+        let bvh = (settings.accel == Accel::Bvh).then(|| {
+            let start = Instant::now();
+            let bvh = pool.install(|| glint::accel::Bvh::build(&snap.scene.shapes));
+            build_s += start.elapsed().as_secs_f64();
+            bvh
+        });
+        let light_buffer = (!counted && Renderer::wants_light_buffer(&snap.scene, settings, &tree))
+            .then(|| pool.install(|| snap.scene.build_light_buffer()))
+            .flatten();
+        Ok(Self {
+            tree,
+            bvh,
+            light_buffer,
+            build_s,
+        })
+    }
+
+    /// The renderer of `scene` (the one these were built for) from its camera.
+    fn renderer<'a>(
+        &'a self,
+        scene: &'a Scene,
+        settings: RenderSettings,
+    ) -> PyResult<Renderer<'a>> {
+        let renderer = Renderer::with_camera(scene, &self.tree, settings, &scene.camera)
+            .map_err(|e| render_error(&e))?
+            .with_light_buffer(self.light_buffer.as_ref());
+        Ok(match &self.bvh {
+            Some(bvh) => renderer.with_bvh(bvh),
+            None => renderer,
+        })
+    }
+
+    fn memory_bytes(&self) -> u64 {
+        self.tree.stats().memory_bytes
+            + self.bvh.as_ref().map_or(0, |b| b.stats().memory_bytes)
+            + self
+                .light_buffer
+                .as_ref()
+                .map_or(0, |b| b.stats().memory_bytes)
     }
 }
 
@@ -275,7 +338,7 @@ impl PyScene {
     }
 
     #[pyo3(signature = (width=None, height=None, samples=None, aa=None, octree=None,
-        max_depth=None, view=None, threads=None, stats=false, protocol=None, colors=None,
+        accel=None, max_depth=None, view=None, threads=None, stats=false, protocol=None, colors=None,
         sides=None, cancel=None, camera=None, frame=None))]
     #[allow(clippy::too_many_arguments)]
     fn render(
@@ -285,6 +348,7 @@ impl PyScene {
         samples: Option<i64>,
         aa: Option<&str>,
         octree: Option<bool>,
+        accel: Option<&str>,
         max_depth: Option<i64>,
         view: Option<&str>,
         threads: Option<usize>,
@@ -308,6 +372,7 @@ impl PyScene {
             samples: count("samples", samples)?,
             aa,
             octree,
+            accel,
             max_depth: count("max_depth", max_depth)?,
             view,
             protocol,
@@ -316,18 +381,9 @@ impl PyScene {
         };
         let settings = options.settings(&snap.scene)?;
         let pool = thread_pool(threads)?;
-        let (tree, build_s) = octree_for(slf, &snap, settings.use_octree, &pool)?;
-        // Shadow rays ask a light buffer first, as `glint render`'s do;
-        // a counted render walks (the buffer would hide the tree's work).
-        let light_buffer = (!stats && Renderer::wants_light_buffer(&snap.scene, &settings, &tree))
-            .then(|| pool.install(|| snap.scene.build_light_buffer()))
-            .flatten();
-        let renderer = Renderer::with_camera(&snap.scene, &tree, settings, &snap.scene.camera)
-            .map_err(|e| render_error(&e))?
-            .with_light_buffer(light_buffer.as_ref());
-        let accel_bytes =
-            tree.stats().memory_bytes + light_buffer.as_ref().map_or(0, |b| b.stats().memory_bytes);
-        glint::render::memory::check_memory(&settings, accel_bytes)
+        let queries = Queries::build(slf, &snap, &settings, &pool, stats)?;
+        let renderer = queries.renderer(&snap.scene, settings)?;
+        glint::render::memory::check_memory(&settings, queries.memory_bytes())
             .map_err(|e| render_error(&e))?;
         let stop = AtomicBool::new(false);
         let pass_options = PassOptions {
@@ -344,7 +400,7 @@ impl PyScene {
         let stats_json = if stats {
             let times = RenderTimes {
                 load_s: snap.load_s,
-                build_s,
+                build_s: queries.build_s,
                 render_s,
             };
             let threads = pool.current_num_threads();
@@ -353,10 +409,14 @@ impl PyScene {
                 &snap.scene,
                 &settings,
                 threads,
-                &tree,
+                &queries.tree,
                 &rendered,
                 times,
             );
+            let report = match &queries.bvh {
+                Some(bvh) => report.with_bvh(bvh.stats()),
+                None => report,
+            };
             Some(json(&report)?)
         } else {
             None
@@ -377,8 +437,8 @@ impl PyScene {
     /// rendered with, so its PNG and record are the ones a local render
     /// writes.
     #[pyo3(signature = (header, pixels, width=None, height=None, samples=None, aa=None,
-        octree=None, max_depth=None, view=None, protocol=None, colors=None, sides=None,
-        camera=None, frame=None))]
+        octree=None, accel=None, max_depth=None, view=None, protocol=None, colors=None,
+        sides=None, camera=None, frame=None))]
     #[allow(clippy::too_many_arguments)]
     fn frame_from_parts(
         slf: &Bound<'_, Self>,
@@ -389,6 +449,7 @@ impl PyScene {
         samples: Option<i64>,
         aa: Option<&str>,
         octree: Option<bool>,
+        accel: Option<&str>,
         max_depth: Option<i64>,
         view: Option<&str>,
         protocol: Option<&str>,
@@ -407,6 +468,7 @@ impl PyScene {
             samples: count("samples", samples)?,
             aa,
             octree,
+            accel,
             max_depth: count("max_depth", max_depth)?,
             view,
             protocol,
@@ -484,7 +546,7 @@ impl PyScene {
 
     /// The `--trace-pixel` JSON of pixel (x, y) of the image these
     /// settings make.
-    #[pyo3(signature = (x, y, width=None, height=None, octree=None, max_depth=None,
+    #[pyo3(signature = (x, y, width=None, height=None, octree=None, accel=None, max_depth=None,
         protocol=None, colors=None, sides=None))]
     #[allow(clippy::too_many_arguments)]
     fn trace_pixel(
@@ -494,6 +556,7 @@ impl PyScene {
         width: Option<i64>,
         height: Option<i64>,
         octree: Option<bool>,
+        accel: Option<&str>,
         max_depth: Option<i64>,
         protocol: Option<&str>,
         colors: Option<&str>,
@@ -504,6 +567,7 @@ impl PyScene {
             width: count("width", width)?,
             height: count("height", height)?,
             octree,
+            accel,
             max_depth: count("max_depth", max_depth)?,
             protocol,
             colors,
@@ -512,9 +576,8 @@ impl PyScene {
         };
         let settings = glint::report::trace_settings(options.settings(&snap.scene)?);
         let pool = thread_pool(None)?;
-        let (tree, _) = octree_for(slf, &snap, settings.use_octree, &pool)?;
-        let renderer = Renderer::with_camera(&snap.scene, &tree, settings, &snap.scene.camera)
-            .map_err(|e| render_error(&e))?;
+        let queries = Queries::build(slf, &snap, &settings, &pool, true)?;
+        let renderer = queries.renderer(&snap.scene, settings)?;
         let report = TraceReport::new(&renderer, &snap.scene, &snap.name, x, y)
             .map_err(|e| PyValueError::new_err(e.to_string()))?;
         json(&report)

@@ -60,6 +60,31 @@ def test_nff_obj_and_octree_off_match_too(tmp_path, glint_cli):
         assert (tmp_path / "python.png").read_bytes() == (tmp_path / "cli.png").read_bytes(), name
 
 
+@pytest.mark.parametrize("accel", ["octree", "bvh", "none"])
+def test_each_accelerator_renders_the_cli_png_and_counts_the_cli_work(tmp_path, glint_cli, accel):
+    path = scene_path("spd/teapot.nff")
+    scene = glint.load(path)
+    frame = scene.render(40, 32, accel=accel, stats=True)
+    glint_cli("render", path, "--width", 40, "--height", 32, "--accel", accel,
+              "--stats", "-q", "-o", tmp_path / "cli.png")
+    frame.save(tmp_path / "python.png")
+    assert (tmp_path / "python.png").read_bytes() == (tmp_path / "cli.png").read_bytes()
+    assert frame.stats["accel"] == accel
+    # Every accelerator answers alike: the pixels are the octree's.
+    assert np.array_equal(frame.srgb8(), scene.render(40, 32).srgb8())
+    assert ("bvh_stats" in frame.stats) == (accel == "bvh")
+
+
+def test_octree_and_accel_that_disagree_or_an_unknown_accel_are_refused():
+    scene = glint.load(scene_path("sphere.toml"))
+    with pytest.raises(ValueError, match="disagree"):
+        scene.render(8, 8, octree=True, accel="bvh")
+    with pytest.raises(ValueError, match="expected octree, bvh or none"):
+        scene.render(8, 8, accel="kd-tree")
+    # Agreeing is allowed.
+    assert scene.render(8, 8, octree=False, accel="none").stats is None
+
+
 @pytest.mark.parametrize("kwargs,flags", SETTINGS[:4], ids=lambda s: str(s))
 def test_stats_are_the_cli_stats(tmp_path, glint_cli, kwargs, flags):
     scene = glint.load(scene_path("default.toml"))

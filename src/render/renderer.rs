@@ -325,16 +325,16 @@ impl Routes {
         // the octree's identity with brute force). Counted queries still
         // walk it, so Havran's counts stay the tree's.
         let route = |counts: bool| {
-            if has_bvh && settings.accel() == Accel::Bvh {
+            if has_bvh && settings.accel == Accel::Bvh {
                 Route::Bvh
-            } else if settings.use_octree && (counts || !octree.is_one_leaf()) {
+            } else if settings.accel == Accel::Octree && (counts || !octree.is_one_leaf()) {
                 Route::Octree
             } else {
                 Route::BruteForce
             }
         };
         let packets =
-            |counts: bool| settings.accel() == Accel::Octree && route(counts) == Route::Octree;
+            |counts: bool| settings.accel == Accel::Octree && route(counts) == Route::Octree;
         Self {
             counted: route(true),
             uncounted: route(false),
@@ -482,7 +482,7 @@ impl<'a> Renderer<'a> {
     /// answers a shadow ray by brute force faster than a look-up and a list.
     pub fn wants_light_buffer(scene: &Scene, settings: &RenderSettings, octree: &Octree) -> bool {
         settings.shadows
-            && match settings.accel() {
+            && match settings.accel {
                 Accel::Bvh => true,
                 Accel::Octree => {
                     !octree.is_one_leaf() || scene.shapes.len() >= LIGHT_BUFFER_MIN_SHAPES
@@ -760,7 +760,7 @@ impl<'a> Renderer<'a> {
         let mut rays = RayCounts::default();
         let mut scratch = Scratch::default();
         // The walk log counts too: each ray's record carries its walk.
-        let mut log = WalkLog::new(self.settings.use_octree);
+        let mut log = WalkLog::new(self.settings.accel == Accel::Octree);
         let mut query = Query {
             counter: &mut log,
             scratch: &mut scratch,

@@ -5,6 +5,7 @@
 //! the tree alone ([`Octree::predicted_cost`], the surface-area model) or
 //! from a sample of the render's own rays ([`sample_rays`]).
 
+use crate::settings::Accel;
 use std::time::Instant;
 
 use serde::Serialize;
@@ -135,7 +136,7 @@ fn thumbnail<'a>(
     settings.height = ((settings.height as f64 * scale).round() as u32).max(1);
     settings.samples = 1;
     settings.adaptive = false;
-    settings.use_octree = true;
+    settings.accel = Accel::Octree;
     Renderer::with_camera(renderer.scene, octree, settings, &renderer.camera_spec)
 }
 

@@ -206,7 +206,7 @@ pub fn bench_scene(
 
     let through = |accel| {
         let mut s = settings;
-        s.set_accel(accel);
+        s.accel = accel;
         s
     };
     let (on, off) = (through(Accel::Octree), through(Accel::BruteForce));

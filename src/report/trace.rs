@@ -2,6 +2,7 @@
 //! spawns, each with its octree walk (schema in docs/inspection.md, "A
 //! pixel's ray tree").
 
+use crate::settings::Accel;
 use serde::Serialize;
 
 use crate::color::ColorConvention;
@@ -87,7 +88,7 @@ impl TraceReport {
             width: settings.width,
             height: settings.height,
             max_depth: settings.max_depth,
-            octree: settings.use_octree,
+            octree: settings.accel == Accel::Octree,
             protocol: settings.protocol,
             colors: settings.colors,
             color: tree.color,

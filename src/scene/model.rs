@@ -2,6 +2,7 @@
 //! and the image settings a file stores with them, and the errors of
 //! reading one. The file formats build it; `mod.rs` only dispatches.
 
+use crate::settings::Accel;
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -156,14 +157,13 @@ impl Scene {
             height: self.image.height,
             samples: self.image.samples,
             max_depth: self.image.max_depth,
-            use_octree: self.octree_enabled,
+            accel: Accel::from_octree_switch(self.octree_enabled),
             view: ViewMode::Shaded,
             protocol: Protocol::Glint,
             colors: self.image.colors,
             sides: self.image.sides,
             adaptive: self.image.adaptive,
             shadows: true,
-            bvh: false,
         }
     }
 

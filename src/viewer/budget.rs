@@ -223,14 +223,13 @@ mod tests {
             height: 600,
             samples: 1,
             max_depth: 5,
-            use_octree: true,
+            accel: crate::settings::Accel::Octree,
             view: crate::settings::ViewMode::Shaded,
             protocol: crate::settings::Protocol::Glint,
             colors: crate::color::ColorConvention::Linear,
             sides: crate::settings::Sides::Two,
             adaptive: false,
             shadows: true,
-            bvh: false,
         }
     }
 

@@ -222,7 +222,7 @@ fn render_settings_ui(edit: &mut EditState, ui: &mut egui::Ui) {
     );
     ui.horizontal(|ui| {
         ui.label("Accelerator");
-        let mut accel = edit.settings.accel();
+        let mut accel = edit.settings.accel;
         for (choice, label, hover) in [
             (Accel::Octree, "Octree", "the octree: glint's default, and what the overlay and walk views show"),
             (Accel::Bvh, "BVH", "a bounding volume hierarchy, to compare: the same image, other build and render times"),
@@ -231,8 +231,8 @@ fn render_settings_ui(edit: &mut EditState, ui: &mut egui::Ui) {
             ui.selectable_value(&mut accel, choice, label)
                 .on_hover_text(hover);
         }
-        if accel != edit.settings.accel() {
-            edit.settings.set_accel(accel);
+        if accel != edit.settings.accel {
+            edit.settings.accel = accel;
         }
     });
     ui.horizontal(|ui| {

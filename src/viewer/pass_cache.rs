@@ -2,6 +2,7 @@
 //! what decides them, so switching back to an image already rendered shows
 //! it at once.
 
+use crate::settings::Accel;
 use std::sync::{Arc, Weak};
 
 use crate::accel::Octree;
@@ -45,7 +46,8 @@ impl PassKey {
         let counts_tests = matches!(settings.view, ViewMode::Cost | ViewMode::CostSteps);
         PassKey {
             scene: Arc::downgrade(scene),
-            octree: (counts_tests || settings.use_octree).then(|| Arc::downgrade(octree)),
+            octree: (counts_tests || settings.accel == Accel::Octree)
+                .then(|| Arc::downgrade(octree)),
             camera,
             settings,
             pass,

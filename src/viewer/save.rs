@@ -2,6 +2,7 @@
 //! NFF (see [`crate::scene::save`]), atomically, then read back to prove it
 //! loads.
 
+use crate::settings::Accel;
 use std::path::{Path, PathBuf};
 
 use super::export::file_dialog_available;
@@ -166,10 +167,9 @@ fn edited_only(edit: &EditState, baseline: &Snapshot) -> (RenderSettings, Octree
     }
     // A scene file says the octree is on or off; the BVH is the viewer's
     // (and a PNG record's) to choose, so choosing it keeps the file's switch.
-    if now.use_octree == was.use_octree || now.bvh {
-        s.use_octree = file.use_octree;
+    if now.accel == was.accel || now.accel == Accel::Bvh {
+        s.accel = file.accel;
     }
-    s.bvh = false;
     let (file, was, now) = (
         &edit.loaded.octree_params,
         &baseline.octree,

@@ -166,8 +166,7 @@ impl Snapshot {
                 r.max_depth,
                 r.colors,
                 r.sides,
-                r.use_octree,
-                r.bvh,
+                r.accel,
             )
         };
         self.camera != other.camera
@@ -230,11 +229,13 @@ impl EditState {
     pub fn flip(&mut self, setting: CompareSetting) {
         let s = &mut self.settings;
         match setting {
-            CompareSetting::Octree => s.set_accel(if s.accel() == Accel::Octree {
-                Accel::BruteForce
-            } else {
-                Accel::Octree
-            }),
+            CompareSetting::Octree => {
+                s.accel = if s.accel == Accel::Octree {
+                    Accel::BruteForce
+                } else {
+                    Accel::Octree
+                }
+            }
             CompareSetting::AntiAliasing => {
                 s.samples = if s.samples > 1 {
                     1
@@ -252,7 +253,7 @@ impl EditState {
             "{}, AA {}, {}, depth {}, {}x{}",
             s.view.name(),
             s.anti_aliasing().name(),
-            match s.accel() {
+            match s.accel {
                 Accel::Octree => "octree on",
                 Accel::Bvh => "BVH",
                 Accel::BruteForce => "octree off",

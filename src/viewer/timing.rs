@@ -209,7 +209,7 @@ fn timing_grid_ui(edit: &EditState, info: &RenderInfo, ui: &mut egui::Ui) {
                 row("rays: refraction", format!("{}", r.rays.refraction));
             }
             // The accelerator's build: (name, seconds, nodes, leaves, bytes).
-            let built = match (edit.settings.accel(), info.bvh) {
+            let built = match (edit.settings.accel, info.bvh) {
                 (Accel::Bvh, Some((bvh, seconds))) => {
                     let s = bvh.stats();
                     Some(("BVH", seconds, s.nodes, s.leaves, s.memory_bytes))

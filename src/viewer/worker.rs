@@ -595,7 +595,7 @@ fn reuse_preview(
             kind: ShownPass::drag_preview(Preview::Reuse),
             seconds,
             rays: summary.rays,
-            accel: settings.accel(),
+            accel: settings.accel,
             anti_aliasing: false,
             width: full.0,
             height: full.1,
@@ -650,8 +650,8 @@ fn render_job(shared: &Shared, generation: u64, job: &Job, light_buffers: &mut L
                 .last_octree_switch
                 .lock()
                 .unwrap_or_else(|e| e.into_inner());
-            let switched = last.is_some_and(|accel| accel != job.settings.accel());
-            *last = Some(job.settings.accel());
+            let switched = last.is_some_and(|accel| accel != job.settings.accel);
+            *last = Some(job.settings.accel);
             switched
         };
         if !switched && show_cached(shared, generation, job, &renderer.plan(true)) {
@@ -723,7 +723,7 @@ fn show_cached(
             history.push(PassRecord {
                 generation,
                 anti_aliasing: job.settings.samples > 1,
-                accel: job.settings.accel(),
+                accel: job.settings.accel,
                 view: job.settings.view,
                 from_cache: true,
                 ..r

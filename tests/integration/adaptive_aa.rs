@@ -3,6 +3,7 @@
 //! stated error of the full grid.
 
 use crate::common;
+use glint::settings::Accel;
 
 use glint::accel::Octree;
 use glint::image::frame::Frame;
@@ -89,7 +90,7 @@ fn adaptive_is_the_same_with_the_octree_off() {
     let on = Renderer::new(&scene, &octree, settings)
         .unwrap()
         .render(false, None);
-    settings.use_octree = false;
+    settings.accel = Accel::BruteForce;
     let off = Renderer::new(&scene, &octree, settings)
         .unwrap()
         .render(false, None);

@@ -2,6 +2,7 @@
 //! reports what it measured when it fails.
 
 use crate::common;
+use glint::settings::Accel;
 
 use common::{diff, load, render_with, scene_from};
 use glint::accel::Octree;
@@ -676,7 +677,10 @@ fn a_light_inside_a_surface_casts_no_speckled_shadow() {
     for use_octree in [true, false] {
         let render = |s: &glint::scene::Scene| {
             let octree = s.build_octree().unwrap();
-            render_with(s, &octree, 96, 72, |st| st.use_octree = use_octree).0
+            render_with(s, &octree, 96, 72, |st| {
+                st.accel = Accel::from_octree_switch(use_octree)
+            })
+            .0
         };
         let (a, b) = (render(&open), render(&lit));
         let differing = a.chunks(3).zip(b.chunks(3)).filter(|(x, y)| x != y).count();

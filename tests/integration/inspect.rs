@@ -2,6 +2,7 @@
 //! aa-need view and reproducible PNG exports.
 
 use crate::common;
+use glint::settings::Accel;
 
 use std::process::Command;
 
@@ -76,7 +77,7 @@ radius = 0.8
 fn settings(scene: &Scene, view: ViewMode, use_octree: bool) -> RenderSettings {
     RenderSettings {
         view,
-        use_octree,
+        accel: Accel::from_octree_switch(use_octree),
         ..scene.render_settings()
     }
 }

@@ -3,6 +3,7 @@
 //! shadows.
 
 use crate::common;
+use glint::settings::Accel;
 
 use common::{all_scenes, render_with};
 use glint::accel::{
@@ -26,11 +27,11 @@ fn octree_on_and_off_and_the_bvh_give_identical_bytes_for_every_scene() {
         let side = if scene.shapes.len() > 20_000 { 12 } else { 40 };
         let (on, c_on) = render_with(scene, octree, side, side, |s| {
             s.samples = 1;
-            s.use_octree = true;
+            s.accel = Accel::Octree;
         });
         let (off, c_off) = render_with(scene, octree, side, side, |s| {
             s.samples = 1;
-            s.use_octree = false;
+            s.accel = Accel::BruteForce;
         });
         let differing = on
             .chunks_exact(3)
@@ -45,7 +46,7 @@ fn octree_on_and_off_and_the_bvh_give_identical_bytes_for_every_scene() {
         let bvh = Bvh::build(&scene.shapes);
         let mut settings = scene.render_settings();
         (settings.width, settings.height, settings.samples) = (side, side, 1);
-        settings.set_accel(glint::settings::Accel::Bvh);
+        settings.accel = glint::settings::Accel::Bvh;
         let light_buffer = scene.build_light_buffer();
         let renderer = Renderer::new(scene, octree, settings)
             .unwrap()
@@ -76,7 +77,7 @@ fn octree_on_and_off_and_the_bvh_give_identical_bytes_for_every_scene() {
             renderer.render(false, None).0.to_rgb8()
         };
         let mut octree_full = full;
-        octree_full.set_accel(glint::settings::Accel::Octree);
+        octree_full.accel = glint::settings::Accel::Octree;
         assert!(
             through(full) == through(octree_full),
             "{name}: 16 samples through the BVH differ from the octree's packets"

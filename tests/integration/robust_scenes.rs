@@ -3,6 +3,7 @@
 //! whose text is too large for a PNG text chunk.
 
 use crate::common;
+use glint::settings::Accel;
 
 use common::{render_with, repo_path, scene_from};
 use glint::accel::{Octree, OctreeParams};
@@ -329,8 +330,8 @@ fn assert_bounded_and_exact(name: &str, text: &str, params: OctreeParams) {
         stats.memory_bytes,
         stats.memory_budget_bytes
     );
-    let (on, counts) = render_with(&scene, &octree, 40, 40, |s| s.use_octree = true);
-    let (off, _) = render_with(&scene, &octree, 40, 40, |s| s.use_octree = false);
+    let (on, counts) = render_with(&scene, &octree, 40, 40, |s| s.accel = Accel::Octree);
+    let (off, _) = render_with(&scene, &octree, 40, 40, |s| s.accel = Accel::BruteForce);
     assert_eq!(counts.nonfinite_samples, 0, "{name}");
     assert!(on == off, "{name}: octree on and off differ");
     eprintln!(
@@ -375,10 +376,10 @@ fn torture_scenes_build_within_budget_and_render_like_brute_force() {
             "{name}: BVH depth {}",
             stats.max_depth
         );
-        let (brute, _) = render_with(&scene, &octree, 40, 40, |s| s.use_octree = false);
+        let (brute, _) = render_with(&scene, &octree, 40, 40, |s| s.accel = Accel::BruteForce);
         let mut settings = scene.render_settings();
         (settings.width, settings.height) = (40, 40);
-        settings.set_accel(glint::settings::Accel::Bvh);
+        settings.accel = glint::settings::Accel::Bvh;
         let renderer = glint::render::Renderer::new(&scene, &octree, settings)
             .unwrap()
             .with_bvh(&bvh);

@@ -3,6 +3,7 @@
 //! the scene glint writes around an OBJ model opened on its own, and a
 //! scene saved with the viewer's edits.
 
+use glint::settings::Accel;
 use std::path::Path;
 
 use glint::export::RenderRecord;
@@ -253,7 +254,7 @@ proptest! {
         (settings.width, settings.height) = size;
         (settings.samples, settings.adaptive) = [(1, false), (16, false), (16, true)][aa];
         settings.max_depth = max_depth;
-        settings.use_octree = octree;
+        settings.accel = Accel::from_octree_switch(octree);
         let lights: Vec<Light> = loaded.lights.iter().zip(&edits.0).map(|(_, (p, c))| Light { position: *p, color: *c }).collect();
         let materials: Vec<Material> = loaded.materials.iter().zip(edits.1.iter().cycle()).map(|(m, (c, kd, n))| Material { color: *c, kd: *kd, shininess: *n, ..m.clone() }).collect();
         let octree_params = glint::accel::OctreeParams {

@@ -3,6 +3,7 @@
 //! scalar path, and casts the same rays.
 
 use crate::common;
+use glint::settings::Accel;
 
 use common::{all_scenes, load, scene_from};
 use glint::accel::Octree;
@@ -103,7 +104,7 @@ fn views_octree_off_and_adaptive_agree_at_every_level() {
         assert_levels_agree(&scene, &octree, &format!("{name} octree off"), |s| {
             s.width = 21;
             s.height = 13;
-            s.use_octree = false;
+            s.accel = Accel::BruteForce;
         });
         assert_levels_agree(&scene, &octree, &format!("{name} adaptive"), |s| {
             s.width = 41;

@@ -21,11 +21,11 @@ use glint::viewer::worker::{ShownPass, Worker};
 fn toggling_octree_and_anti_aliasing_restarts_the_passes() {
     let mut h = harness(small_app());
     let before = h.state().worker().generation();
-    assert!(h.state().settings().use_octree);
+    assert!(h.state().settings().accel == Accel::Octree);
     h.get_by_label("None").click();
     h.run_steps(2);
     assert!(
-        !h.state().settings().use_octree,
+        h.state().settings().accel != Accel::Octree,
         "\"None\" turns the octree off"
     );
     let after_octree = h.state().worker().generation();
@@ -98,7 +98,7 @@ fn export_writes_the_displayed_buffer() {
 #[test]
 fn pin_as_a_then_octree_off_reads_zero_pixels_differ() {
     let mut app = small_app();
-    app.settings_mut().use_octree = true;
+    app.settings_mut().accel = Accel::Octree;
     let mut h = harness(app);
     settle(&mut h);
     h.get_by_label("Pin as A").click();
@@ -106,7 +106,7 @@ fn pin_as_a_then_octree_off_reads_zero_pixels_differ() {
     assert!(h.state().compare().is_some(), "A is pinned");
     h.get_by_label("None").click();
     h.run_steps(2);
-    assert!(!h.state().settings().use_octree);
+    assert!(h.state().settings().accel != Accel::Octree);
     settle(&mut h);
     let stats = h.state().compare_stats().expect("A and B compared");
     let generation = h.state().worker().generation();
@@ -163,7 +163,7 @@ fn an_accelerator_change_renders_and_the_panel_waits_for_the_new_figures() {
     ] {
         h.get_by_label(label).click();
         h.run_steps(2);
-        assert_eq!(h.state().settings().accel(), accel);
+        assert_eq!(h.state().settings().accel, accel);
         let on = accel.name();
         let generation = h.state().worker().generation();
         // The labels of the last frame drawn, then whether the pass was
@@ -571,7 +571,7 @@ fn the_image_is_magnified_by_whole_pixels_to_fit_or_one_to_one() {
 fn a_long_pass_can_be_stopped_and_the_next_change_renders_again() {
     let worker = Worker::spawn(2, || {});
     let (mut slow, _, _) = job("scenes/default.toml", 96, 72, AntiAliasing::Full);
-    slow.settings.use_octree = false;
+    slow.settings.accel = Accel::BruteForce;
     let generation = worker.submit(slow);
     let start = std::time::Instant::now();
     while worker.with_buffer(|b| b.tiles_done) < 1 {

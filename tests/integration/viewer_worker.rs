@@ -3,6 +3,7 @@
 #![cfg(feature = "gui")]
 
 use crate::common;
+use glint::settings::Accel;
 
 use std::sync::Arc;
 use std::time::Duration;
@@ -283,7 +284,7 @@ fn view_switches_show_passes_already_rendered_without_rendering() {
         );
     }
     let mut brute_force = off.clone();
-    brute_force.settings.use_octree = false;
+    brute_force.settings.accel = Accel::BruteForce;
     let g = worker.submit(brute_force);
     assert!(worker.wait_finished(g, WAIT));
     assert!(

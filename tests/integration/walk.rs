@@ -3,6 +3,7 @@
 //! Havran counts the render itself keeps.
 
 use crate::common;
+use glint::settings::Accel;
 
 use glint::accel::{QueryRecord, StepKind, WalkEnd};
 use glint::render::Renderer;
@@ -27,7 +28,7 @@ fn settings(scene: &Scene, use_octree: bool) -> RenderSettings {
     s.height = SIZE.1;
     s.samples = 1;
     s.adaptive = false;
-    s.use_octree = use_octree;
+    s.accel = Accel::from_octree_switch(use_octree);
     s
 }
 

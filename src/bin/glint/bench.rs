@@ -1,5 +1,6 @@
 //! `glint bench`: octree on against off, interleaved repeats, medians.
 
+use glint::settings::Accel;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -336,7 +337,7 @@ fn sweep(args: &BenchArgs) -> Result<()> {
     for path in &args.scenes {
         let (mut scene, _) = load_scene(path)?;
         let mut settings = bench_settings(args, &mut scene);
-        settings.use_octree = true;
+        settings.accel = Accel::Octree;
         say!("sweep {}", path.display());
         // Every setting's shadow rays ask the same light buffer first, as
         // a render's do: the sweep varies only the tree.

@@ -35,26 +35,24 @@ impl AccelArg {
     /// `--accel` and the older `--octree on|off` together: either alone,
     /// or both when they agree; `None` when neither is given (the scene's
     /// setting).
-    pub fn resolve(accel: Option<AccelArg>, octree: Option<Switch>) -> Result<Option<AccelArg>> {
-        let from_switch = octree.map(|s| {
-            if s.is_on() {
-                AccelArg::Octree
-            } else {
-                AccelArg::None
-            }
-        });
-        match (accel, from_switch) {
-            (Some(a), Some(o)) if a != o => anyhow::bail!(
+    pub fn resolve(
+        accel: Option<AccelArg>,
+        octree: Option<Switch>,
+    ) -> Result<Option<glint::settings::Accel>> {
+        let named = accel.map(AccelArg::accel);
+        let switched = octree.map(|s| glint::settings::Accel::from_octree_switch(s.is_on()));
+        match (named, switched) {
+            (Some(a), Some(s)) if a != s => anyhow::bail!(
                 "--octree {} and --accel {} disagree: give one of them",
-                if o == AccelArg::Octree { "on" } else { "off" },
+                if s == glint::settings::Accel::Octree {
+                    "on"
+                } else {
+                    "off"
+                },
                 a.name()
             ),
-            (a, o) => Ok(a.or(o)),
+            (a, s) => Ok(a.or(s)),
         }
-    }
-
-    pub fn name(self) -> &'static str {
-        self.accel().name()
     }
 
     pub fn accel(self) -> glint::settings::Accel {
@@ -72,8 +70,7 @@ pub use glint::report::median;
 /// The progress bar on the terminal, if one is shown: the Ctrl+C handler
 /// silences it before ending its line, so no redraw from a render thread
 /// lands after that line end.
-static TERMINAL_BAR: std::sync::Mutex<Option<indicatif::ProgressBar>> =
-    std::sync::Mutex::new(None);
+static TERMINAL_BAR: std::sync::Mutex<Option<indicatif::ProgressBar>> = std::sync::Mutex::new(None);
 
 /// A progress bar of `len` steps drawn with `template`, when stderr is a
 /// terminal; `None` otherwise (a log or a pipe gets no redraws).

@@ -118,7 +118,7 @@ fn write_info(
     writeln!(
         out,
         "octree        {} (max depth {}, leaf size {}, cost-driven {}, max duplication {}, budget {} MiB)",
-        match r.accel() {
+        match r.accel {
             glint::settings::Accel::Octree => "on",
             glint::settings::Accel::Bvh => "off, a BVH instead",
             glint::settings::Accel::BruteForce => "off",

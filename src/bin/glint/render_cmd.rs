@@ -254,8 +254,7 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
     if let Some(switch) = args.legend {
         legend = switch.is_on();
     }
-    let mut overrides = overrides(args);
-    overrides.accel = AccelArg::resolve(args.accel, args.octree)?.map(AccelArg::accel);
+    let overrides = overrides(args)?;
     overrides.apply(&mut settings, &mut scene.octree_params);
 
     let threads = pool.current_num_threads();
@@ -266,13 +265,13 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
         "--overlay-depth sets how deep the octree overlay draws: add --overlay octree \
          (or render again a PNG that recorded an overlay, with --from-png)"
     );
-    let octree = if settings.use_octree || overlay_depth.is_some() {
+    let octree = if settings.accel == Accel::Octree || overlay_depth.is_some() {
         pool.install(|| scene.build_octree())
             .with_context(|| format!("cannot build the octree of {scene_name}"))?
     } else {
         Octree::build(&[], scene.octree_params)?
     };
-    let bvh = (settings.accel() == Accel::Bvh).then(|| pool.install(|| Bvh::build(&scene.shapes)));
+    let bvh = (settings.accel == Accel::Bvh).then(|| pool.install(|| Bvh::build(&scene.shapes)));
     let build_s = build_start.elapsed().as_secs_f64();
     // `--stats` renders counting the accelerator's work, which the
     // buffer would hide: there it is not built.
@@ -314,19 +313,19 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
 }
 
 /// What the flags ask for instead of the scene's (or the record's) settings.
-fn overrides(args: &RenderArgs) -> Overrides {
+fn overrides(args: &RenderArgs) -> Result<Overrides> {
     let mut o = Overrides {
         width: args.width,
         height: args.height,
         anti_aliasing: crate::common::anti_aliasing(args.samples, args.aa),
         max_depth: args.max_depth,
-        use_octree: args.octree.map(Switch::is_on),
+        accel: AccelArg::resolve(args.accel, args.octree)?,
         octree: args.octree_params.overrides(),
         view: args.view,
         ..Overrides::default()
     };
     args.rules.add_to(&mut o);
-    o
+    Ok(o)
 }
 
 /// Renders every pass of the frame with a progress bar on a terminal;

@@ -5,6 +5,7 @@
 //! preview resolution (1/1, 1/2, 1/4 against the full-resolution image).
 //! Writes `DIR/study.md` and difference images `DIR/*.png`.
 
+use glint::settings::Accel;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -144,7 +145,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
         say!("study {}", path.display());
         let mut base = scene.render_settings();
         (base.width, base.height) = (w, h);
-        base.use_octree = true;
+        base.accel = Accel::Octree;
         let study = Study {
             octree: scene.build_octree()?,
             light_buffer: scene.build_light_buffer(),

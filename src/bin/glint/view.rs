@@ -158,9 +158,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         width: args.size.map(|(w, _)| w),
         height: args.size.map(|(_, h)| h),
         anti_aliasing: args.aa,
-        use_octree: args.octree.map(Switch::is_on),
-        accel: crate::common::AccelArg::resolve(args.accel, args.octree)?
-            .map(crate::common::AccelArg::accel),
+        accel: crate::common::AccelArg::resolve(args.accel, args.octree)?,
         view: args.view,
         ..Overrides::default()
     };

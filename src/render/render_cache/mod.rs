@@ -57,6 +57,7 @@ mod point;
 mod reproject;
 mod trace;
 
+use crate::settings::Accel;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -176,8 +177,7 @@ impl Basis {
         // The samples and accelerator change nothing a preview shows.
         settings.samples = 1;
         settings.adaptive = false;
-        settings.use_octree = true;
-        settings.bvh = false;
+        settings.accel = Accel::Octree;
         Self {
             shapes: Arc::clone(&scene.shapes),
             shape_colors: Arc::clone(&scene.shape_colors),

@@ -166,7 +166,7 @@ fn the_light_buffer_changes_no_answer() {
     assert!(blocked > 300 && lit > 300, "{blocked} blocked, {lit} lit");
     // Brute force stays brute force; a moved light finds no buffer.
     let mut off = scene.render_settings();
-    off.use_octree = false;
+    off.accel = Accel::BruteForce;
     let brute = Renderer::new(&scene, &octree, off).unwrap();
     assert!(!brute.with_light_buffer(buffer.as_ref()).has_light_buffer());
     let mut moved = scene.clone();
@@ -194,14 +194,14 @@ fn a_one_leaf_tree_sends_only_counted_queries_through_the_octree() {
         assert_eq!(routes(&renderer), (Octree, uncounted, true, packets));
         // A BVH takes every query, counted or not, and no packets;
         // asked for but not given, the settings' octree switch decides.
-        settings.set_accel(Accel::Bvh);
+        settings.accel = Accel::Bvh;
         let without = Renderer::new(scene, &octree, settings).unwrap();
         assert_eq!(routes(&without), (BruteForce, BruteForce, false, false));
         let with = Renderer::new(scene, &octree, settings)
             .unwrap()
             .with_bvh(&bvh);
         assert_eq!(routes(&with), (Bvh, Bvh, false, false));
-        settings.set_accel(Accel::BruteForce);
+        settings.accel = Accel::BruteForce;
         let brute = Renderer::new(scene, &octree, settings)
             .unwrap()
             .with_bvh(&bvh);
@@ -271,7 +271,7 @@ fn shadow_rays_skipping_their_plane_change_no_picture() {
             &scene,
             &octree,
             RenderSettings {
-                use_octree: false,
+                accel: Accel::BruteForce,
                 ..settings
             },
         )

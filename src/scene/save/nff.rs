@@ -1,6 +1,7 @@
 //! Saving an NFF scene: its own text with the numbers the viewer edits
 //! rewritten in place.
 
+use crate::settings::Accel;
 use std::ops::Range;
 
 use super::{LeftOut, SaveError, SaveRequest, SavedText};
@@ -83,7 +84,7 @@ pub fn scene_nff(request: &SaveRequest) -> Result<SavedText, SaveError> {
             }
         }
     }
-    if s.use_octree != loaded.octree_enabled {
+    if (s.accel == Accel::Octree) != loaded.octree_enabled {
         left_out.push(LeftOut::OctreeSwitch);
     }
     if *request.octree != loaded.octree_params {

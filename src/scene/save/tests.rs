@@ -5,6 +5,7 @@ use super::*;
 use crate::material::Light;
 use crate::math::DVec3;
 use crate::scene::{FileSource, load_str};
+use crate::settings::Accel;
 use toml_edit::DocumentMut;
 
 struct NoMeshes;
@@ -65,7 +66,7 @@ fn edits_are_written_and_comments_and_untouched_numbers_kept() {
     settings.width = 640;
     settings.samples = 16;
     settings.adaptive = true;
-    settings.use_octree = false;
+    settings.accel = Accel::BruteForce;
     let mut lights = loaded.lights.clone();
     lights[0].color = DVec3::new(0.5, 0.25, 1.0);
     let mut materials = loaded.materials.clone();

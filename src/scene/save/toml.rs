@@ -1,5 +1,6 @@
 //! Saving a TOML scene: its own text edited in place with `toml_edit`.
 
+use crate::settings::Accel;
 use std::path::Path;
 
 use toml_edit::{Array, DocumentMut, Item, TableLike, Value};
@@ -177,10 +178,10 @@ fn write_octree(doc: &mut DocumentMut, loaded: &OctreeParams, edited: &OctreePar
 }
 
 fn write_settings(doc: &mut DocumentMut, loaded: &Scene, s: &RenderSettings) {
-    if s.use_octree != loaded.octree_enabled
+    if (s.accel == Accel::Octree) != loaded.octree_enabled
         && let Some(t) = table(doc, "octree")
     {
-        set(t, "enabled", Value::from(s.use_octree));
+        set(t, "enabled", Value::from(s.accel == Accel::Octree));
     }
     if s.protocol != Protocol::Glint {
         return;

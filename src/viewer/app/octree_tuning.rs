@@ -24,7 +24,7 @@ impl GlintApp {
     /// one, built here the first time, as the octree is (it builds far
     /// faster: 0.02 s for gears' 36,610 shapes, where the octree takes 0.9 s).
     pub(super) fn bvh_if_chosen(&mut self) -> Option<Arc<Bvh>> {
-        if self.edit.settings.accel() != Accel::Bvh {
+        if self.edit.settings.accel != Accel::Bvh {
             return None;
         }
         let shapes = &self.edit.scene.shapes;
@@ -106,7 +106,7 @@ impl GlintApp {
             scene: Arc::clone(&self.edit.scene),
             octree: Arc::clone(&self.octree),
             settings: RenderSettings {
-                use_octree: true,
+                accel: Accel::Octree,
                 ..self.edit.settings
             },
             camera: self.edit.camera,
@@ -133,7 +133,7 @@ impl GlintApp {
         }
         if self.unit_costs.is_none() && !self.worker.history().is_empty() {
             let settings = RenderSettings {
-                use_octree: true,
+                accel: Accel::Octree,
                 ..self.edit.settings
             };
             if let Ok(renderer) =

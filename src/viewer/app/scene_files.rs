@@ -132,7 +132,7 @@ impl GlintApp {
                         LeftOut::MaxDepth => b.max_depth = file.max_depth,
                         LeftOut::Colors => b.colors = file.colors,
                         LeftOut::Sides => b.sides = file.sides,
-                        LeftOut::OctreeSwitch => b.use_octree = file.use_octree,
+                        LeftOut::OctreeSwitch => b.accel = file.accel,
                         LeftOut::OctreeParams => baseline.octree = reloaded.octree_params,
                         LeftOut::CameraPath => {
                             baseline.camera_path.clone_from(&reloaded.camera_path)
@@ -217,10 +217,10 @@ impl GlintApp {
         if take_camera {
             edit.camera = scene.camera;
             // The new scene's own settings (its colour convention among
-            // them), keeping the view, the octree switch and the protocol.
+            // them), keeping the view, the accelerator and the protocol.
             edit.settings = RenderSettings {
                 view: edit.settings.view,
-                use_octree: edit.settings.use_octree,
+                accel: edit.settings.accel,
                 ..scene.render_settings()
             }
             .with_protocol(edit.settings.protocol);

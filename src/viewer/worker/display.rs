@@ -172,7 +172,7 @@ impl PassWatch for Display<'_> {
                 },
                 seconds: summary.seconds,
                 rays: summary.counts.rays,
-                accel: self.settings.accel(),
+                accel: self.settings.accel,
                 anti_aliasing: self.job.settings.samples > 1,
                 width: pass.frame.width,
                 height: pass.frame.height,
