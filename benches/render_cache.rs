@@ -43,15 +43,13 @@ fn main() {
     let ms: f64 = args.get(2).and_then(|a| a.parse().ok()).unwrap_or(12.0);
     let every: usize = args.get(3).and_then(|a| a.parse().ok()).unwrap_or(15);
     let scene = glint::scene::load(std::path::Path::new(path)).expect("scene");
-    let octree = scene.build_octree().expect("octree");
-    let buffer = scene.build_light_buffer();
     let mut settings = scene.render_settings();
+    let accel =
+        glint::render::Accelerator::build(&scene, &settings, Default::default()).expect("octree");
     let final_settings = settings;
     settings.set_anti_aliasing(AntiAliasing::Off);
     let renderer_at = |camera: &CameraSpec, s| {
-        Renderer::with_camera(&scene, &octree, s, camera)
-            .expect("renderer")
-            .with_light_buffer(buffer.as_ref())
+        Renderer::with_camera(&scene, &accel, s, camera).expect("renderer")
     };
     let start_camera = scene.camera;
     let (seed_frame, _) = renderer_at(&start_camera, final_settings).render(false, None);

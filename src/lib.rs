@@ -3,12 +3,11 @@
 //!
 //! ```no_run
 //! let scene = glint::scene::load(std::path::Path::new("scenes/sphere.toml"))?;
-//! let octree = scene.build_octree()?;
 //! let settings = scene.render_settings();
-//! // Optional: shadow rays ask it which shapes they can meet first.
-//! let light_buffer = scene.build_light_buffer();
-//! let renderer = glint::render::Renderer::new(&scene, &octree, settings)?
-//!     .with_light_buffer(light_buffer.as_ref());
+//! // What the settings choose ray queries to go through (the octree, a
+//! // BVH or none), built once, with the light buffer shadow rays ask.
+//! let accel = glint::render::Accelerator::build(&scene, &settings, Default::default())?;
+//! let renderer = glint::render::Renderer::new(&scene, &accel, settings)?;
 //! let (frame, _counts) = renderer.render(false, None);
 //! glint::export::save_png(&frame, std::path::Path::new("sphere.png"), None)?;
 //! # Ok::<(), Box<dyn std::error::Error>>(())

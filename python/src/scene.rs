@@ -12,7 +12,9 @@ use pyo3::types::PyTuple;
 
 use glint::accel::{Octree, OctreeParams};
 use glint::export::SceneEdits;
-use glint::render::{PassInfo, PassOptions, PassWatch, Renderer};
+use glint::render::{
+    Accelerator, LightBufferSource, PassInfo, PassOptions, PassWatch, Renderer, Reuse,
+};
 use glint::report::{RenderStats, RenderTimes, TraceReport};
 use glint::scene::{KeyValue, Scene};
 use glint::settings::{Accel, RenderSettings};
@@ -144,81 +146,46 @@ fn snapshot(slf: &Bound<'_, PyScene>) -> Snapshot {
 }
 
 /// What a render's ray queries go through, built as `glint render` builds
-/// it: the octree (kept between renders), the BVH when `accel='bvh'`, and
-/// the light buffer shadow rays ask first (not for a counted render: it
-/// would hide the accelerator's work).
-struct Queries {
-    tree: Arc<Octree>,
-    bvh: Option<glint::accel::Bvh>,
-    light_buffer: Option<glint::accel::LightBuffer>,
-    build_s: f64,
-}
-
-impl Queries {
-    fn build(
-        slf: &Bound<'_, PyScene>,
-        snap: &Snapshot,
-        settings: &RenderSettings,
-        pool: &rayon::ThreadPool,
-        counted: bool,
-    ) -> PyResult<Self> {
-        let (tree, mut build_s) = octree_for(slf, snap, settings.accel == Accel::Octree, pool)?;
-        let bvh = (settings.accel == Accel::Bvh).then(|| {
-            let start = Instant::now();
-            let bvh = pool.install(|| glint::accel::Bvh::build(&snap.scene.shapes));
-            build_s += start.elapsed().as_secs_f64();
-            bvh
-        });
-        let light_buffer = (!counted && Renderer::wants_light_buffer(&snap.scene, settings, &tree))
-            .then(|| pool.install(|| snap.scene.build_light_buffer()))
-            .flatten();
-        Ok(Self {
-            tree,
-            bvh,
-            light_buffer,
-            build_s,
-        })
-    }
-
-    /// The renderer of `scene` (the one these were built for) from its camera.
-    fn renderer<'a>(
-        &'a self,
-        scene: &'a Scene,
-        settings: RenderSettings,
-    ) -> PyResult<Renderer<'a>> {
-        let renderer = Renderer::with_camera(scene, &self.tree, settings, &scene.camera)
-            .map_err(|e| render_error(&e))?
-            .with_light_buffer(self.light_buffer.as_ref());
-        Ok(match &self.bvh {
-            Some(bvh) => renderer.with_bvh(bvh),
-            None => renderer,
-        })
-    }
-
-    fn memory_bytes(&self) -> u64 {
-        self.tree.stats().memory_bytes
-            + self.bvh.as_ref().map_or(0, |b| b.stats().memory_bytes)
-            + self
-                .light_buffer
-                .as_ref()
-                .map_or(0, |b| b.stats().memory_bytes)
-    }
+/// it: the octree kept between renders (when the settings ask for it),
+/// and no light buffer for a counted render (it would hide the
+/// accelerator's work). Returns it and the seconds its parts took.
+fn accelerator(
+    slf: &Bound<'_, PyScene>,
+    snap: &Snapshot,
+    settings: &RenderSettings,
+    pool: &rayon::ThreadPool,
+    counted: bool,
+) -> PyResult<(Accelerator, f64)> {
+    let (octree, octree_s) = if settings.accel == Accel::Octree {
+        let (tree, seconds) = octree_for(slf, snap, pool)?;
+        (Some(tree), seconds)
+    } else {
+        (None, 0.0)
+    };
+    let reuse = Reuse {
+        octree,
+        bvh: None,
+        light_buffer: if counted {
+            LightBufferSource::Given(None)
+        } else {
+            LightBufferSource::Build
+        },
+    };
+    let accel = pool
+        .install(|| Accelerator::build(&snap.scene, settings, reuse))
+        .map_err(|e| octree_error(&e))?;
+    let build_s = octree_s + accel.build_seconds().0;
+    Ok((accel, build_s))
 }
 
 /// The scene's octree, built with the GIL released unless the last one
-/// built has the same parameters; with the octree off, an empty one (as
-/// `glint render --octree off`). Returns it and its build's seconds.
+/// built has the same parameters. Returns it and its build's seconds.
 fn octree_for(
     slf: &Bound<'_, PyScene>,
     snap: &Snapshot,
-    use_octree: bool,
     pool: &rayon::ThreadPool,
 ) -> PyResult<(Arc<Octree>, f64)> {
     let params = snap.scene.octree_params;
-    if !use_octree {
-        let empty = Octree::build(&[], params).map_err(|e| octree_error(&e))?;
-        return Ok((Arc::new(empty), 0.0));
-    }
     if let Some(c) = snap.cached.as_ref().filter(|c| c.params == params) {
         return Ok((c.tree.clone(), c.build_s));
     }
@@ -381,9 +348,10 @@ impl PyScene {
         };
         let settings = options.settings(&snap.scene)?;
         let pool = thread_pool(threads)?;
-        let queries = Queries::build(slf, &snap, &settings, &pool, stats)?;
-        let renderer = queries.renderer(&snap.scene, settings)?;
-        glint::render::memory::check_memory(&settings, queries.memory_bytes())
+        let (accel, build_s) = accelerator(slf, &snap, &settings, &pool, stats)?;
+        let renderer =
+            Renderer::new(&snap.scene, &accel, settings).map_err(|e| render_error(&e))?;
+        glint::render::memory::check_memory(&settings, accel.memory_bytes())
             .map_err(|e| render_error(&e))?;
         let stop = AtomicBool::new(false);
         let pass_options = PassOptions {
@@ -400,7 +368,7 @@ impl PyScene {
         let stats_json = if stats {
             let times = RenderTimes {
                 load_s: snap.load_s,
-                build_s: queries.build_s,
+                build_s,
                 render_s,
             };
             let threads = pool.current_num_threads();
@@ -409,14 +377,10 @@ impl PyScene {
                 &snap.scene,
                 &settings,
                 threads,
-                &queries.tree,
+                &accel,
                 &rendered,
                 times,
             );
-            let report = match &queries.bvh {
-                Some(bvh) => report.with_bvh(bvh.stats()),
-                None => report,
-            };
             Some(json(&report)?)
         } else {
             None
@@ -576,8 +540,9 @@ impl PyScene {
         };
         let settings = glint::report::trace_settings(options.settings(&snap.scene)?);
         let pool = thread_pool(None)?;
-        let queries = Queries::build(slf, &snap, &settings, &pool, true)?;
-        let renderer = queries.renderer(&snap.scene, settings)?;
+        let (accel, _) = accelerator(slf, &snap, &settings, &pool, true)?;
+        let renderer =
+            Renderer::new(&snap.scene, &accel, settings).map_err(|e| render_error(&e))?;
         let report = TraceReport::new(&renderer, &snap.scene, &snap.name, x, y)
             .map_err(|e| PyValueError::new_err(e.to_string()))?;
         json(&report)

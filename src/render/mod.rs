@@ -7,6 +7,7 @@
 //! `bench`, `study` and the viewer all render through
 //! [`Renderer::render_frame`].
 
+mod accelerator;
 pub mod adaptive;
 mod corners;
 mod integrator;
@@ -22,6 +23,7 @@ mod unit_costs;
 
 mod renderer;
 
+pub use accelerator::{Accelerator, LightBufferSource, Reuse, Structure};
 pub use passes::{
     FinishedPass, FinishedTile, PassInfo, PassKind, PassOptions, PassSummary, PassWatch,
     RenderedFrame, pass_settings,
@@ -77,8 +79,8 @@ mod tests {
     }
 
     fn render(scene: &Scene) -> (Frame, RenderCounts) {
-        let octree = scene.build_octree().unwrap();
-        Renderer::new(scene, &octree, scene.render_settings())
+        let accel = crate::render::Accelerator::of_octree(scene, scene.build_octree().unwrap());
+        Renderer::new(scene, &accel, scene.render_settings())
             .unwrap()
             .render(false, None)
     }
@@ -193,9 +195,9 @@ mod tests {
     fn the_renderer_refuses_settings_outside_the_limits() {
         let mut s = scene(4, 5, vec![Material::default()], DVec3::Z);
         s.push(Shape::Plane(Plane::new(DVec3::ZERO, DVec3::Z)), 0);
-        let octree = s.build_octree().unwrap();
+        let accel = crate::render::Accelerator::of_octree(&s, s.build_octree().unwrap());
         let base = s.render_settings();
-        let with = |settings| Renderer::new(&s, &octree, settings).err();
+        let with = |settings| Renderer::new(&s, &accel, settings).err();
         assert!(with(base).is_none());
         assert!(matches!(
             with(RenderSettings { samples: 8, ..base }),
@@ -225,7 +227,7 @@ mod tests {
         }
         let mut s = scene(6, 5, vec![Material::default()], DVec3::Z);
         s.push(Shape::Plane(Plane::new(DVec3::ZERO, DVec3::Z)), 0);
-        let octree = s.build_octree().unwrap();
+        let accel = crate::render::Accelerator::of_octree(&s, s.build_octree().unwrap());
         for (samples, view) in [
             (1, ViewMode::Shaded),
             (16, ViewMode::Shaded),
@@ -237,7 +239,7 @@ mod tests {
                 view,
                 ..s.render_settings()
             };
-            let renderer = Renderer::new(&s, &octree, settings).unwrap();
+            let renderer = Renderer::new(&s, &accel, settings).unwrap();
             let seen = Seen(Default::default());
             let options = PassOptions {
                 count_work: false,

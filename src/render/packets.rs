@@ -14,7 +14,7 @@
 // Lane loops index several arrays by the same lane number.
 #![allow(clippy::needless_range_loop)]
 
-use crate::accel::{ClosestHit, PacketStack, Primitives};
+use crate::accel::{ClosestHit, Octree, PacketStack, Primitives};
 use crate::math::{Color, DVec3, Ray};
 use crate::render::ray_tree::{NoRecord, RayKind, RayRecorder};
 use crate::shapes::{PacketHits, PreparedRay, RayPacket, ShapeHit};
@@ -66,20 +66,20 @@ impl LaneWork for PacketTile<'_, '_> {
 /// A packet's closest hits, as a function of its own per SIMD level: the
 /// walk with its shape tests inlined is the largest code glint compiles,
 /// and the four places that trace eye rays share it.
-struct ClosestWalk<'w, 'r, 'a, C, const N: usize> {
-    renderer: &'r Renderer<'a>,
+struct ClosestWalk<'w, 'r, C, const N: usize> {
+    octree: &'r Octree,
     prims: &'w Primitives<'r>,
     packet: &'w RayPacket<N>,
     stack: &'w mut PacketStack<N>,
     counter: &'w mut C,
 }
 
-impl<C: Counter, const N: usize> pulp::WithSimd for ClosestWalk<'_, '_, '_, C, N> {
+impl<C: Counter, const N: usize> pulp::WithSimd for ClosestWalk<'_, '_, C, N> {
     type Output = PacketHits<N>;
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _simd: S) -> PacketHits<N> {
-        self.renderer.octree.closest_packet(
+        self.octree.closest_packet(
             self.prims,
             self.packet,
             splat(f64::INFINITY),
@@ -310,12 +310,12 @@ impl Renderer<'_> {
         query: &mut Query<C>,
         stack: &mut PacketScratch<N>,
     ) -> [Option<ClosestHit>; N] {
-        if self.packets_through_octree::<C>()
+        if let Some(octree) = self.walked_octree::<C>()
             && let Some(packet) = RayPacket::<N>::from_rays(rays)
         {
             let prims = self.primitives();
             let best = simd.vectorize(ClosestWalk {
-                renderer: self,
+                octree,
                 prims: &prims,
                 packet: &packet,
                 stack: &mut stack.walk,

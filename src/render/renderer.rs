@@ -4,14 +4,15 @@
 //! force) the integrator asks.
 
 use crate::accel::{
-    BoxLanes, Bvh, BvhStack, Candidates, ClosestHit, LightBuffer, Octree, OneByOne, Primitives,
-    ShadowCrossings, ShapeRange, SkippingPlanes, WalkLog, WalkStack, closest_brute_force,
-    occlusion_among, occlusion_among_in_lanes, occlusion_brute_force,
+    BoxLanes, Bvh, BvhStack, Candidates, ClosestHit, Octree, OneByOne, Primitives, ShadowCrossings,
+    ShapeRange, SkippingPlanes, WalkLog, WalkStack, closest_brute_force, occlusion_among,
+    occlusion_among_in_lanes, occlusion_brute_force,
 };
 use crate::camera::{Camera, CameraError, CameraSpec, sample_offsets};
 use crate::limits::LimitError;
 use crate::material::Material;
 use crate::math::{Color, DVec3};
+use crate::render::accelerator::{Accelerator, Structure};
 use crate::render::ray_tree::{RayKind, RayNode};
 use crate::scene::Scene;
 use crate::settings::{Accel, RenderSettings, Sides, ViewMode};
@@ -25,6 +26,16 @@ pub enum RenderError {
     Camera(#[from] CameraError),
     #[error(transparent)]
     Limit(#[from] LimitError),
+    #[error(transparent)]
+    Octree(#[from] crate::accel::OctreeError),
+    #[error(
+        "the settings ask for --accel {asked}, and the accelerator given is {built}: \
+         build it from these settings"
+    )]
+    AccelMismatch {
+        asked: &'static str,
+        built: &'static str,
+    },
     #[error(
         "a {width}x{height} render needs about {need} MiB of memory, more than the {limit} MiB \
          this machine has available: choose a smaller image",
@@ -243,50 +254,16 @@ impl pulp::WithSimd for BvhQuery<'_> {
 /// far below any thickness a scene models.
 const SAME_SURFACE_RELATIVE: f64 = 1e-9;
 
-/// Where a renderer sends its ray queries.
-#[derive(Clone, Copy, PartialEq, Eq, Debug)]
-enum Route {
-    Bvh,
-    Octree,
-    BruteForce,
-}
-
-/// Where counted and uncounted queries go, decided once per renderer so a
-/// query pays one branch, as brute force does: on a two-shape scene the
-/// per-query checks of settings and tree were most of what the octree's
-/// whole run cost above brute force's.
-#[derive(Clone, Copy, Debug)]
-struct Routes {
-    counted: Route,
-    uncounted: Route,
-    /// Whether eye rays go through the octree's packet walk, likewise.
-    counted_packets: bool,
-    uncounted_packets: bool,
-}
-
-/// A scene of fewer shapes than this whose octree is one leaf (so its
-/// shadow rays go brute force) gets no light buffer: whole runs of
-/// sphere.toml, triangle.toml and lights.toml (1-3 spheres and a plane)
-/// took 5-8 % longer with one, while quadrics.toml (5 quadrics and a
-/// plane) took 6 % less.
-const LIGHT_BUFFER_MIN_SHAPES: usize = 5;
-
 /// A scene prepared for rendering with fixed settings.
 pub struct Renderer<'a> {
     pub(super) scene: &'a Scene,
-    pub(super) octree: &'a Octree,
-    /// When given, every query goes through it instead of the octree or
-    /// brute force ([`Renderer::with_bvh`]).
-    bvh: Option<&'a Bvh>,
-    routes: Routes,
+    /// What every query goes through, built for these settings.
+    accel: &'a Accelerator,
     /// Whether shadow rays test the shape that last blocked their light's
     /// first ([`ShadowHint`]): not on a scene of a few shapes, where the
     /// query costs about what the hint does (1 % more instructions per
     /// ray on the two- to six-shape scenes).
     shadow_hints: bool,
-    /// Per light, the shapes that can block each direction of its shadow
-    /// rays ([`Renderer::with_light_buffer`]); uncounted queries only.
-    light_buffer: Option<&'a LightBuffer>,
     pub(super) settings: RenderSettings,
     pub(super) camera: Camera,
     /// What `camera` was made from (a thumbnail of the same view needs it).
@@ -316,52 +293,32 @@ pub struct Renderer<'a> {
     pub(super) single_rays: SingleRays,
 }
 
-impl Routes {
-    fn new(settings: &RenderSettings, octree: &Octree, has_bvh: bool) -> Self {
-        // A tree that is one leaf (a scene of a few shapes) holds every
-        // bounded shape, so its walk tests what brute force tests, after
-        // the root's box, the walk's setup and, for eye rays, the packets'
-        // lanes: uncounted queries go brute force there (the same hits, by
-        // the octree's identity with brute force). Counted queries still
-        // walk it, so Havran's counts stay the tree's.
-        let route = |counts: bool| {
-            if has_bvh && settings.accel == Accel::Bvh {
-                Route::Bvh
-            } else if settings.accel == Accel::Octree && (counts || !octree.is_one_leaf()) {
-                Route::Octree
-            } else {
-                Route::BruteForce
-            }
-        };
-        let packets =
-            |counts: bool| settings.accel == Accel::Octree && route(counts) == Route::Octree;
-        Self {
-            counted: route(true),
-            uncounted: route(false),
-            counted_packets: packets(true),
-            uncounted_packets: packets(false),
-        }
-    }
-}
-
 impl<'a> Renderer<'a> {
+    /// The renderer of `scene` with `settings`, its queries through
+    /// `accel` (built with [`Accelerator::build`] from the same settings).
     pub fn new(
         scene: &'a Scene,
-        octree: &'a Octree,
+        accel: &'a Accelerator,
         settings: RenderSettings,
     ) -> Result<Self, RenderError> {
-        Self::with_camera(scene, octree, settings, &scene.camera)
+        Self::with_camera(scene, accel, settings, &scene.camera)
     }
 
     /// Like [`Renderer::new`], seen from `camera` instead of the scene's own
     /// (the viewer moves the camera without touching the scene).
     pub fn with_camera(
         scene: &'a Scene,
-        octree: &'a Octree,
+        accel: &'a Accelerator,
         settings: RenderSettings,
         camera: &CameraSpec,
     ) -> Result<Self, RenderError> {
         settings.check()?;
+        if settings.accel != accel.kind() {
+            return Err(RenderError::AccelMismatch {
+                asked: settings.accel.name(),
+                built: accel.kind().name(),
+            });
+        }
         let camera_spec = *camera;
         let camera = Camera::new(camera, settings.width, settings.height)?;
         let is_transparent: Vec<bool> = scene
@@ -390,13 +347,10 @@ impl<'a> Renderer<'a> {
         let triangle_lanes = Primitives::mostly_triangles(&scene.shapes);
         Ok(Self {
             scene,
-            octree,
-            bvh: None,
-            routes: Routes::new(&settings, octree, false),
+            accel,
             shadow_hints: scene.shapes.len() > HINTS_MIN_SHAPES,
             triangle_lanes,
-            skips_planes: triangle_lanes && octree.planes().has_groups(),
-            light_buffer: None,
+            skips_planes: triangle_lanes && accel.planes().is_some_and(|p| p.has_groups()),
             settings,
             camera,
             camera_spec,
@@ -450,69 +404,24 @@ impl<'a> Renderer<'a> {
         self.simd
     }
 
-    /// The BVH (built over this scene's shapes) that queries go through
-    /// when the settings ask for one ([`Accel::Bvh`]); without it they
-    /// test every shape. The bytes are the same either way, only the time
-    /// and the work counted differ. Its rays go one at a time (the packet
-    /// walks are the octree's).
-    pub fn with_bvh(mut self, bvh: &'a Bvh) -> Self {
-        self.bvh = Some(bvh);
-        self.routes = Routes::new(&self.settings, self.octree, true);
-        self
-    }
-
-    /// The light buffer (built over this scene's shapes and lights) that
-    /// shadow rays ask first which shapes they can meet; a buffer of other
-    /// lights or another number of shapes is ignored, and so is any
-    /// buffer when shadows are off or queries go brute force (it would
-    /// hide what the octree buys). The bytes are the same either way;
-    /// counted queries never use it, so Havran's counts stay the
-    /// accelerator's.
-    pub fn with_light_buffer(mut self, buffer: Option<&'a LightBuffer>) -> Self {
-        let lights: Vec<_> = self.scene.lights.iter().map(|l| l.position).collect();
-        let useful = Self::wants_light_buffer(self.scene, &self.settings, self.octree);
-        self.light_buffer = buffer.filter(|b| useful && b.fits(self.scene.shapes.len(), &lights));
-        self
-    }
-
-    /// Whether a render of `scene` with `settings` over `octree` would
-    /// ask a light buffer (so whether to build one): with shadows, through
-    /// the BVH or the octree. Brute force stays brute force, and a one-leaf
-    /// tree's scene of fewer than five shapes
-    /// answers a shadow ray by brute force faster than a look-up and a list.
-    pub fn wants_light_buffer(scene: &Scene, settings: &RenderSettings, octree: &Octree) -> bool {
-        settings.shadows
-            && match settings.accel {
-                Accel::Bvh => true,
-                Accel::Octree => {
-                    !octree.is_one_leaf() || scene.shapes.len() >= LIGHT_BUFFER_MIN_SHAPES
-                }
-                Accel::BruteForce => false,
-            }
-    }
-
     /// Whether shadow rays ask a light buffer first.
     pub fn has_light_buffer(&self) -> bool {
-        self.light_buffer.is_some()
+        self.accel.light_buffer().is_some()
     }
 
-    /// Where queries counted by `C` go.
-    #[inline(always)]
-    fn route<C: Counter>(&self) -> Route {
-        if C::COUNTS {
-            self.routes.counted
-        } else {
-            self.routes.uncounted
-        }
+    /// What this renderer's queries go through.
+    pub fn accelerator(&self) -> &'a Accelerator {
+        self.accel
     }
 
-    /// Whether eye rays (counted by `C`) go through the octree's packet walk.
+    /// The octree queries counted by `C` walk, if they walk one: counted
+    /// queries always do (Havran's counts are the tree's); uncounted ones
+    /// go brute force over a one-leaf tree, which holds every shape.
     #[inline(always)]
-    pub(super) fn packets_through_octree<C: Counter>(&self) -> bool {
-        if C::COUNTS {
-            self.routes.counted_packets
-        } else {
-            self.routes.uncounted_packets
+    pub(super) fn walked_octree<C: Counter>(&self) -> Option<&'a Octree> {
+        match self.accel.structure() {
+            Structure::Octree(tree) if C::COUNTS || self.accel.walks_uncounted() => Some(tree),
+            _ => None,
         }
     }
 
@@ -529,10 +438,9 @@ impl<'a> Renderer<'a> {
     /// shape `shape`, skips ([`crate::accel::PlaneGroups::left_behind`]).
     #[inline(always)]
     pub(super) fn left_behind(&self, shape: u32, origin: DVec3, dir: DVec3) -> ShapeRange {
-        if self.skips_planes {
-            self.octree.planes().left_behind(shape, origin, dir)
-        } else {
-            ShapeRange::EMPTY
+        match self.accel.planes() {
+            Some(planes) if self.skips_planes => planes.left_behind(shape, origin, dir),
+            _ => ShapeRange::EMPTY,
         }
     }
 
@@ -565,10 +473,7 @@ impl<'a> Renderer<'a> {
         query: &mut Query<C>,
     ) -> Option<ClosestHit> {
         let prims = self.primitives();
-        let route = self.route::<C>();
-        if route == Route::Bvh
-            && let Some(bvh) = self.bvh
-        {
+        if let Structure::Bvh(bvh) = self.accel.structure() {
             let stack = &mut query.scratch.bvh;
             if !C::COUNTS
                 && let Some(simd) = self.single_rays.avx2()
@@ -585,7 +490,7 @@ impl<'a> Renderer<'a> {
             }
             return bvh.closest(&prims, ray, f64::INFINITY, stack, query.counter);
         }
-        if route == Route::Octree {
+        if let Some(octree) = self.walked_octree::<C>() {
             let stack = &mut query.scratch.stack;
             if !C::COUNTS
                 && let Some(simd) = self.single_rays.avx2()
@@ -593,15 +498,14 @@ impl<'a> Renderer<'a> {
                 return self.single(
                     simd,
                     ClosestQuery {
-                        octree: self.octree,
+                        octree,
                         prims: &prims,
                         ray,
                         stack,
                     },
                 );
             }
-            self.octree
-                .closest(&prims, ray, f64::INFINITY, stack, query.counter)
+            octree.closest(&prims, ray, f64::INFINITY, stack, query.counter)
         } else {
             closest_brute_force(&prims, ray, f64::INFINITY, query.counter)
         }
@@ -653,8 +557,7 @@ impl<'a> Renderer<'a> {
             }
             hint = Some((h, tested));
         }
-        let route = self.route::<C>();
-        let few = match self.light_buffer {
+        let few = match self.accel.light_buffer() {
             Some(buffer) if !C::COUNTS => match buffer.candidates(light, ray) {
                 Candidates::Few(list) => Some([buffer.unbounded(), list]),
                 Candidates::Many => None,
@@ -675,9 +578,7 @@ impl<'a> Renderer<'a> {
                 ),
                 None => occlusion_among(&prims, lists, ray, distance, crossings, query.counter),
             }
-        } else if route == Route::Bvh
-            && let Some(tree) = self.bvh
-        {
+        } else if let Structure::Bvh(tree) = self.accel.structure() {
             match self.single_rays.avx2() {
                 Some(simd) if !C::COUNTS => {
                     let query = BvhQuery {
@@ -692,12 +593,12 @@ impl<'a> Renderer<'a> {
                 }
                 _ => tree.occlusion(&prims, ray, distance, crossings, bvh, query.counter),
             }
-        } else if route == Route::Octree {
+        } else if let Some(octree) = self.walked_octree::<C>() {
             match self.single_rays.avx2() {
                 Some(simd) if !C::COUNTS => self.single_shadow(
                     simd,
                     OcclusionQuery {
-                        octree: self.octree,
+                        octree,
                         prims: &prims,
                         ray,
                         distance,
@@ -705,9 +606,7 @@ impl<'a> Renderer<'a> {
                         stack,
                     },
                 ),
-                _ => self
-                    .octree
-                    .occlusion(&prims, ray, distance, crossings, stack, query.counter),
+                _ => octree.occlusion(&prims, ray, distance, crossings, stack, query.counter),
             }
         } else {
             occlusion_brute_force(&prims, ray, distance, crossings, query.counter);

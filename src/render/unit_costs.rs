@@ -5,7 +5,7 @@
 //! the tree alone ([`Octree::predicted_cost`], the surface-area model) or
 //! from a sample of the render's own rays ([`sample_rays`]).
 
-use crate::settings::Accel;
+use std::sync::Arc;
 use std::time::Instant;
 
 use serde::Serialize;
@@ -17,7 +17,9 @@ use crate::math::{Aabb, DVec3, Ray, orthonormal_basis};
 use crate::shapes::{PreparedRay, Shape};
 use crate::stats::{NoCounts, RenderCounts, WorkCounts};
 
+use super::accelerator::{Accelerator, Reuse};
 use super::renderer::{RenderError, Renderer};
+use crate::settings::Accel;
 
 /// Nanoseconds per unit of work, on one thread.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
@@ -43,7 +45,7 @@ impl UnitCosts {
     /// `octree` with random lines (less their tests), and the rest of a
     /// ray from a thumbnail render of the scene (less its steps and
     /// tests). Takes some tens of milliseconds.
-    pub fn measure(renderer: &Renderer, octree: &Octree) -> Result<Self, RenderError> {
+    pub fn measure(renderer: &Renderer, octree: &Arc<Octree>) -> Result<Self, RenderError> {
         let shapes = &renderer.scene.shapes;
         let lines: Vec<PreparedRay> = random_lines(octree.bounds(), 2048)
             .into_iter()
@@ -91,7 +93,8 @@ impl UnitCosts {
             / walked.traversal_steps.max(1) as f64;
 
         // A thumbnail of the render, one thread, for what else a ray costs.
-        let thumbnail = thumbnail(renderer, octree, 48)?;
+        let accel = through_octree(renderer, octree)?;
+        let thumbnail = thumbnail(renderer, &accel, 48)?;
         let on_one_thread = on_one_thread(&thumbnail);
         let mut counts = Default::default();
         let render_s = fastest_of_3(|| counts = on_one_thread(true));
@@ -124,10 +127,10 @@ impl UnitCosts {
 }
 
 /// The render `renderer` would make, at most `side` pixels on its longer
-/// side and one sample per pixel, through `octree`.
+/// side and one sample per pixel, through `accel` ([`through_octree`]).
 fn thumbnail<'a>(
     renderer: &Renderer<'a>,
-    octree: &'a Octree,
+    accel: &'a Accelerator,
     side: u32,
 ) -> Result<Renderer<'a>, RenderError> {
     let mut settings = renderer.settings;
@@ -137,7 +140,21 @@ fn thumbnail<'a>(
     settings.samples = 1;
     settings.adaptive = false;
     settings.accel = Accel::Octree;
-    Renderer::with_camera(renderer.scene, octree, settings, &renderer.camera_spec)
+    Renderer::with_camera(renderer.scene, accel, settings, &renderer.camera_spec)
+}
+
+/// `octree` (one over `renderer`'s scene) as the accelerator of its
+/// thumbnails, without a light buffer: the sample measures the tree.
+fn through_octree(renderer: &Renderer, octree: &Arc<Octree>) -> Result<Accelerator, RenderError> {
+    let settings = crate::settings::RenderSettings {
+        accel: Accel::Octree,
+        ..renderer.settings
+    };
+    Ok(Accelerator::build(
+        renderer.scene,
+        &settings,
+        Reuse::octree_alone(octree),
+    )?)
 }
 
 /// Renders `thumbnail` (counted or not) on a pool of one thread, for
@@ -203,7 +220,7 @@ impl RaySample {
 /// shading and packets cost on this machine. The pixel grid is coarser
 /// than the render's, so edges weigh a little more. The counts are the
 /// same on any number of threads; the time is taken on one.
-pub fn sample_rays(renderer: &Renderer, octree: &Octree) -> Result<RaySample, RenderError> {
+pub fn sample_rays(renderer: &Renderer, octree: &Arc<Octree>) -> Result<RaySample, RenderError> {
     sample_rays_with(renderer, octree, None)
 }
 
@@ -216,10 +233,11 @@ const PER_DOUBLING_RANGE: (f64, f64) = (0.5, 1.0);
 /// thumbnail at twice the side.
 pub fn sample_rays_with(
     renderer: &Renderer,
-    octree: &Octree,
+    octree: &Arc<Octree>,
     per_doubling: Option<f64>,
 ) -> Result<RaySample, RenderError> {
-    let thumbnail = thumbnail(renderer, octree, RAY_SAMPLE_SIDE)?;
+    let accel = through_octree(renderer, octree)?;
+    let thumbnail = thumbnail(renderer, &accel, RAY_SAMPLE_SIDE)?;
     let seconds_per_ray = |thumbnail: &Renderer| {
         let on_one_thread = on_one_thread(thumbnail);
         let mut rays = 0;
@@ -239,7 +257,7 @@ pub fn sample_rays_with(
         Some(p) => p,
         None if doublings > 0.0 => {
             // Twice the side, or the render's own if that is smaller.
-            let larger = self::thumbnail(renderer, octree, 2 * RAY_SAMPLE_SIDE)?;
+            let larger = self::thumbnail(renderer, &accel, 2 * RAY_SAMPLE_SIDE)?;
             let steps = (side(&larger.settings) / side(&thumbnail.settings)).log2();
             if steps < 0.5 {
                 1.0
@@ -365,7 +383,7 @@ pub fn suggest_octree(
             };
             let start = Instant::now();
             // Over the budget a build is refused: not a candidate.
-            let Ok(octree) = Octree::build(&renderer.scene.shapes, params) else {
+            let Ok(octree) = Octree::build(&renderer.scene.shapes, params).map(Arc::new) else {
                 continue;
             };
             let build_s = start.elapsed().as_secs_f64();
@@ -437,11 +455,11 @@ mod tests {
         // At 40x30 and one sample the thumbnail is the render itself: the
         // sample's work per ray is the counted render's, exactly.
         let scene = lattice(DVec3::new(3.0, 4.0, 12.0), DVec3::ZERO, 40, 30);
-        let octree = scene.build_octree().unwrap();
-        let renderer = Renderer::new(&scene, &octree, scene.render_settings()).unwrap();
+        let accel = crate::render::Accelerator::of_octree(&scene, scene.build_octree().unwrap());
+        let renderer = Renderer::new(&scene, &accel, scene.render_settings()).unwrap();
         let counts = renderer.render(true, None).1;
         let rays = counts.rays.total() as f64;
-        let sample = sample_rays(&renderer, &octree).unwrap();
+        let sample = sample_rays(&renderer, accel.octree().unwrap()).unwrap();
         assert_eq!(sample.rays, counts.rays.total());
         assert_eq!(
             sample.traversal_steps_per_ray,
@@ -462,11 +480,11 @@ mod tests {
         // 320 pixels a side is 320 / 64 = 5 times the sample's, and 16
         // samples per pixel are 4 times more rays a side again.
         let scene = lattice(DVec3::new(3.0, 4.0, 12.0), DVec3::ZERO, 320, 240);
-        let octree = scene.build_octree().unwrap();
+        let accel = crate::render::Accelerator::of_octree(&scene, scene.build_octree().unwrap());
         let mut settings = scene.render_settings();
         settings.samples = 16;
-        let renderer = Renderer::new(&scene, &octree, settings).unwrap();
-        let sample = sample_rays(&renderer, &octree).unwrap();
+        let renderer = Renderer::new(&scene, &accel, settings).unwrap();
+        let sample = sample_rays(&renderer, accel.octree().unwrap()).unwrap();
         assert!(
             (sample.doublings - 20f64.log2()).abs() < 1e-12,
             "{sample:?}"
@@ -476,7 +494,7 @@ mod tests {
         assert_eq!(sample.seconds_per_ray_at_render(), carried);
         assert_eq!(sample.predict(1000, 2).render_s, 1000.0 * carried / 2.0);
         // A factor given is used as given.
-        let given = sample_rays_with(&renderer, &octree, Some(0.75)).unwrap();
+        let given = sample_rays_with(&renderer, accel.octree().unwrap(), Some(0.75)).unwrap();
         assert_eq!(given.per_doubling, 0.75);
     }
 
@@ -495,15 +513,16 @@ mod tests {
             320,
             240,
         );
-        let octree = towards.build_octree().unwrap();
+        let accel =
+            crate::render::Accelerator::of_octree(&towards, towards.build_octree().unwrap());
         let sample = |scene: &Scene| {
-            let renderer = Renderer::new(scene, &octree, scene.render_settings()).unwrap();
-            sample_rays(&renderer, &octree).unwrap()
+            let renderer = Renderer::new(scene, &accel, scene.render_settings()).unwrap();
+            sample_rays(&renderer, accel.octree().unwrap()).unwrap()
         };
         let (seen, unseen) = (sample(&towards), sample(&away));
         assert_eq!(unseen.traversal_steps_per_ray, 0.0);
         assert_eq!(unseen.intersection_tests_per_ray, 0.0);
-        let model = octree.predicted_cost();
+        let model = accel.octree().unwrap().predicted_cost();
         assert!(seen.intersection_tests_per_ray > 0.0);
         assert!(
             seen.intersection_tests_per_ray < model.intersection_tests_per_ray,

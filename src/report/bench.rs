@@ -2,12 +2,16 @@
 //! force, interleaved repeats, medians, and the cost the tree predicts;
 //! its JSON record ([`SceneBench`]) is `glint bench --format json`'s.
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use serde::Serialize;
 
 use crate::accel::{Bvh, BvhStats, LightBufferStats, OctreeError, OctreeParams, OctreeStats};
-use crate::render::{Prediction, RenderError, Renderer, UnitCosts, sample_rays};
+use crate::render::{
+    Accelerator, LightBufferSource, Prediction, RenderError, Renderer, Reuse, UnitCosts,
+    sample_rays,
+};
 use crate::scene::Scene;
 use crate::settings::{Accel, Protocol, RenderSettings};
 use crate::simd::SimdLevel;
@@ -217,28 +221,47 @@ pub fn bench_scene(
             check()?;
             let (tree, s) = timed(|| pool.install(|| Bvh::build(&scene.shapes)));
             bvh_build_times.push(s);
-            bvh = Some(tree);
+            bvh = Some(Arc::new(tree));
         }
     }
+    // The octree's accelerator `repeat` times, for the light buffer's
+    // build time (the tree is reused); the BVH's shares its buffer.
+    let octree = Arc::new(octree);
     let mut light_buffer_times = Vec::new();
-    let mut light_buffer = None;
-    let wants = |accel| Renderer::wants_light_buffer(scene, &through(accel), &octree);
-    if wants(Accel::Octree) || (options.bvh && wants(Accel::Bvh)) {
-        for _ in 0..options.repeat {
-            check()?;
-            let (buffer, s) = timed(|| pool.install(|| scene.build_light_buffer()));
-            light_buffer_times.push(s);
-            light_buffer = buffer;
-        }
+    let mut accel_on = None;
+    for _ in 0..options.repeat {
+        check()?;
+        let reuse = Reuse {
+            octree: Some(Arc::clone(&octree)),
+            ..Reuse::default()
+        };
+        let built = pool.install(|| Accelerator::build(scene, &on, reuse))?;
+        light_buffer_times.push(built.build_seconds().1);
+        accel_on = Some(built);
     }
-    let renderer_on = Renderer::new(scene, &octree, on)?.with_light_buffer(light_buffer.as_ref());
-    let renderer_off = Renderer::new(scene, &octree, off)?;
-    let renderer_bvh = bvh
-        .as_ref()
-        .map(|b| {
-            Renderer::new(scene, &octree, through(Accel::Bvh))
-                .map(|r| r.with_bvh(b).with_light_buffer(light_buffer.as_ref()))
+    let Some(accel_on) = accel_on else {
+        return Err(BenchError::NoRepeats);
+    };
+    let accel_off = Accelerator::build(scene, &off, Reuse::default())?;
+    let accel_bvh = bvh
+        .map(|tree| {
+            let light_buffer = match accel_on.shared_light_buffer() {
+                Some(b) => LightBufferSource::Given(Some(Arc::clone(b))),
+                None => LightBufferSource::Build,
+            };
+            let reuse = Reuse {
+                bvh: Some(tree),
+                light_buffer,
+                ..Reuse::default()
+            };
+            pool.install(|| Accelerator::build(scene, &through(Accel::Bvh), reuse))
         })
+        .transpose()?;
+    let renderer_on = Renderer::new(scene, &accel_on, on)?;
+    let renderer_off = Renderer::new(scene, &accel_off, off)?;
+    let renderer_bvh = accel_bvh
+        .as_ref()
+        .map(|a| Renderer::new(scene, a, through(Accel::Bvh)))
         .transpose()?;
     check()?;
     let counted_bvh = renderer_bvh
@@ -360,18 +383,26 @@ pub fn bench_scene(
                     every > 1,
                 )
             }),
-        bvh: bvh
+        bvh: accel_bvh
             .as_ref()
+            .and_then(Accelerator::bvh)
             .zip(counted_bvh.as_ref())
             .map(|(b, c)| BvhBench {
                 build_s: median(bvh_build_times.clone()),
                 bvh_stats: b.stats(),
                 timing: timing(c, median(full_bvh.clone()), c.rays.total() as f64, false),
             }),
-        light_buffer: light_buffer.as_ref().map(|b| LightBufferBench {
-            build_s: median(light_buffer_times.clone()),
-            stats: b.stats(),
-        }),
+        light_buffer: match (accel_on.light_buffer(), &accel_bvh) {
+            (Some(b), _) => Some(LightBufferBench {
+                build_s: median(light_buffer_times.clone()),
+                stats: b.stats(),
+            }),
+            (None, Some(a)) => a.light_buffer().map(|b| LightBufferBench {
+                build_s: a.build_seconds().1,
+                stats: b.stats(),
+            }),
+            (None, None) => None,
+        },
         speedup,
         compared_rows_every: every,
         counting_overhead: median(counted_times) / on_s,

@@ -5,9 +5,9 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-use crate::accel::{BvhStats, Octree, OctreeParams, OctreeStats};
+use crate::accel::{BvhStats, OctreeParams, OctreeStats};
 use crate::color::ColorConvention;
-use crate::render::RenderedFrame;
+use crate::render::{Accelerator, RenderedFrame};
 use crate::scene::{DroppedPolygons, MeshCounts, Scene, SkippedElements};
 use crate::settings::{Accel, AntiAliasing, Protocol, RenderSettings, Sides, ViewMode};
 use crate::stats::RayCounts;
@@ -97,14 +97,14 @@ pub struct RenderTimes {
 impl RenderStats {
     /// The statistics of `rendered`: `scene` (named `scene_name`, as the
     /// user gave it) rendered with `settings` on `threads` threads through
-    /// `octree`. Its work counts are zero unless the frame was rendered
+    /// `accel`. Its work counts are zero unless the frame was rendered
     /// with work counting on.
     pub fn new(
         scene_name: &str,
         scene: &Scene,
         settings: &RenderSettings,
         threads: usize,
-        octree: &Octree,
+        accel: &Accelerator,
         rendered: &RenderedFrame,
         times: RenderTimes,
     ) -> Self {
@@ -160,21 +160,13 @@ impl RenderStats {
             skipped_elements: scene.skipped_elements.clone(),
             not_rendered: scene.not_rendered.clone(),
             load_notes: scene.load_notes.clone(),
-            octree_stats: (settings.accel == Accel::Octree).then(|| octree.stats()),
-            bvh_stats: None,
+            octree_stats: accel.octree().map(|t| t.stats()),
+            bvh_stats: accel.bvh().map(|t| t.stats()),
             cost_per_pixel: frame.cost_summary().map(|c| CostJson {
                 min: c.min,
                 max: c.max,
                 mean: c.mean,
             }),
-        }
-    }
-
-    /// With the statistics of the BVH the render went through.
-    pub fn with_bvh(self, stats: BvhStats) -> Self {
-        Self {
-            bvh_stats: Some(stats),
-            ..self
         }
     }
 }

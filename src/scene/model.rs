@@ -141,7 +141,7 @@ impl Scene {
     }
 
     /// The light buffer of this scene's lights over its shapes, for
-    /// [`crate::render::Renderer::with_light_buffer`]; `None` without
+    /// [`crate::render::Accelerator::build`]; `None` without
     /// lights or for a scene too large to project quickly.
     pub fn build_light_buffer(&self) -> Option<LightBuffer> {
         let lights: Vec<_> = self.lights.iter().map(|l| l.position).collect();

@@ -294,7 +294,12 @@ impl GlintApp {
 
     /// Picks pixel `(i, j)` and shows the tree of rays its centre ray spawns.
     pub fn inspect_pixel(&mut self, i: u32, j: u32) {
-        if let Err(e) = self.inspect.inspect_pixel(&self.edit, &self.octree, (i, j)) {
+        // The pixel's walks are counted: no light buffer.
+        let reuse = crate::render::Reuse {
+            bvh: self.bvh_if_chosen(),
+            ..crate::render::Reuse::octree_alone(&self.octree)
+        };
+        if let Err(e) = self.inspect.inspect_pixel(&self.edit, reuse, (i, j)) {
             self.say(format!("cannot inspect: {e}"), true);
         }
     }

@@ -63,10 +63,10 @@ impl InspectState {
     pub fn inspect_pixel(
         &mut self,
         edit: &EditState,
-        octree: &Octree,
+        reuse: crate::render::Reuse,
         pixel: (u32, u32),
     ) -> Result<(), RenderError> {
-        if let Some(inspection) = Inspection::trace(edit, octree, pixel)? {
+        if let Some(inspection) = Inspection::trace(edit, reuse, pixel)? {
             self.inspection = Some(inspection);
         }
         Ok(())

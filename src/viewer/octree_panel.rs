@@ -44,12 +44,11 @@ impl SuggestionJob {
         let (out, stop) = (Arc::clone(&result), Arc::clone(&cancel));
         std::thread::spawn(move || {
             let keep_going = || !stop.load(Ordering::Relaxed);
-            let found =
-                Renderer::with_camera(&view.scene, &view.octree, view.settings, &view.camera)
-                    .ok()
-                    .and_then(|renderer| {
-                        suggest_octree(&renderer, &costs, rays, threads, &keep_going)
-                    });
+            let found = view.accelerator().and_then(|accel| {
+                let renderer =
+                    Renderer::with_camera(&view.scene, &accel, view.settings, &view.camera).ok()?;
+                suggest_octree(&renderer, &costs, rays, threads, &keep_going)
+            });
             if let Ok(mut slot) = out.lock() {
                 *slot = Some(found.map(|(candidates, best)| candidates[best]));
             }
@@ -89,11 +88,13 @@ impl RaySampleJob {
         let out = Arc::clone(&result);
         let octree = Arc::clone(&view.octree);
         std::thread::spawn(move || {
-            let sample =
-                Renderer::with_camera(&view.scene, &view.octree, view.settings, &view.camera)
-                    .and_then(|renderer| sample_rays(&renderer, &view.octree));
+            let sample = view.accelerator().and_then(|accel| {
+                let renderer =
+                    Renderer::with_camera(&view.scene, &accel, view.settings, &view.camera).ok()?;
+                sample_rays(&renderer, &view.octree).ok()
+            });
             if let Ok(mut slot) = out.lock() {
-                *slot = Some(sample.ok());
+                *slot = Some(sample);
             }
         });
         Self { octree, result }
@@ -116,6 +117,15 @@ pub struct SuggestionView {
     pub octree: Arc<Octree>,
     pub settings: RenderSettings,
     pub camera: CameraSpec,
+}
+
+impl SuggestionView {
+    /// The view's octree as its thumbnails' accelerator (`settings` ask
+    /// for the octree).
+    fn accelerator(&self) -> Option<crate::render::Accelerator> {
+        let reuse = crate::render::Reuse::octree_alone(&self.octree);
+        crate::render::Accelerator::build(&self.scene, &self.settings, reuse).ok()
+    }
 }
 
 /// What the panel shows besides the parameters.

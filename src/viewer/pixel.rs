@@ -4,7 +4,6 @@
 use egui::{Color32, Pos2, Rect, Stroke};
 
 use super::state::EditState;
-use crate::accel::Octree;
 use crate::camera::Camera;
 use crate::math::DVec3;
 use crate::render::ray_tree::{RayKind, RayNode, ShadowVerdict};
@@ -47,7 +46,7 @@ impl Inspection {
     /// A pixel outside the image picks nothing.
     pub fn trace(
         edit: &EditState,
-        octree: &Octree,
+        reuse: crate::render::Reuse,
         (i, j): (u32, u32),
     ) -> Result<Option<Self>, RenderError> {
         let settings = RenderSettings {
@@ -58,7 +57,8 @@ impl Inspection {
         if i >= settings.width || j >= settings.height {
             return Ok(None);
         }
-        let renderer = Renderer::with_camera(&edit.scene, octree, settings, &edit.camera)?;
+        let accel = crate::render::Accelerator::build(&edit.scene, &settings, reuse)?;
+        let renderer = Renderer::with_camera(&edit.scene, &accel, settings, &edit.camera)?;
         Ok(Some(Inspection {
             pixel: (i, j),
             tree: renderer.ray_tree(i, j),

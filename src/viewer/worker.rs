@@ -29,7 +29,6 @@ mod reuse;
 
 use crate::image::frame::{Frame, rgb_to_rgba};
 use crate::render::{PassOptions, Renderer};
-use crate::scene::Scene;
 use display::Display;
 pub use display::{DisplayBuffer, FrameSource};
 pub use job::Job;
@@ -464,27 +463,15 @@ fn reuse_preview(
     settings.height = full.1.div_ceil(scale);
     // A buffer is built for a new scene, but not again while a light is
     // dragged: its build would take a preview's time every frame.
-    let light_buffer = if Renderer::wants_light_buffer(&job.scene, &settings, &job.octree) {
-        light_buffers.kept(&job.scene)
-    } else {
-        None
+    let built = job.accelerator(&job.scene, &settings, light_buffers.kept(&job.scene));
+    let accel = match built {
+        Ok(a) => a,
+        Err(e) => {
+            shared.fail(format!("cannot render: {e}"));
+            return;
+        }
     };
-    fn renderer_at<'a>(
-        scene: &'a Scene,
-        job: &'a Job,
-        settings: crate::settings::RenderSettings,
-        camera: &crate::camera::CameraSpec,
-        light_buffer: Option<&'a crate::accel::LightBuffer>,
-    ) -> Result<Renderer<'a>, crate::render::RenderError> {
-        Renderer::with_camera(scene, &job.octree, settings, camera).map(|r| {
-            match &job.bvh {
-                Some(bvh) => r.with_bvh(bvh),
-                None => r,
-            }
-            .with_light_buffer(light_buffer)
-        })
-    }
-    let renderer = match renderer_at(&job.scene, job, settings, &job.camera, light_buffer) {
+    let renderer = match Renderer::with_camera(&job.scene, &accel, settings, &job.camera) {
         Ok(r) => r,
         Err(e) => {
             shared.fail(format!("cannot render: {e}"));
@@ -521,9 +508,18 @@ fn reuse_preview(
             _ => None,
         }
     };
-    let seed_renderer = seed.as_ref().and_then(|(_, source)| {
-        renderer_at(&source.scene, job, settings, &source.camera, light_buffer).ok()
+    // The seed's scene may have its lights elsewhere: the kept buffer
+    // serves it only if it is of those lights.
+    let seed_accel = seed.as_ref().and_then(|(_, source)| {
+        job.accelerator(&source.scene, &settings, light_buffers.kept(&source.scene))
+            .ok()
     });
+    let seed_renderer = seed
+        .as_ref()
+        .zip(seed_accel.as_ref())
+        .and_then(|((_, source), accel)| {
+            Renderer::with_camera(&source.scene, accel, settings, &source.camera).ok()
+        });
     if seed_renderer.is_some() {
         state.cache.clear();
     }
@@ -625,20 +621,20 @@ fn render_job(shared: &Shared, generation: u64, job: &Job, light_buffers: &mut L
         }
         settings.shadows = p.shadows;
     }
-    let built = Renderer::wants_light_buffer(&job.scene, &settings, &job.octree)
-        .then(|| light_buffers.get(&job.scene))
-        .flatten();
-    let light_buffer = built.map(|(b, _)| b);
+    let accel = match job.accelerator(&job.scene, &settings, light_buffers.current(&job.scene)) {
+        Ok(a) => a,
+        Err(e) => {
+            shared.fail(format!("cannot render: {e}"));
+            return;
+        }
+    };
+    let seconds = light_buffers.keep(&job.scene, &accel);
     *shared
         .light_buffer
         .lock()
-        .unwrap_or_else(|e| e.into_inner()) = built.map(|(b, seconds)| (b.stats(), seconds));
-    let renderer = match Renderer::with_camera(&job.scene, &job.octree, settings, &job.camera) {
-        Ok(r) => match &job.bvh {
-            Some(bvh) => r.with_bvh(bvh),
-            None => r,
-        }
-        .with_light_buffer(light_buffer),
+        .unwrap_or_else(|e| e.into_inner()) = accel.light_buffer().map(|b| (b.stats(), seconds));
+    let renderer = match Renderer::with_camera(&job.scene, &accel, settings, &job.camera) {
+        Ok(r) => r,
         Err(e) => {
             shared.fail(format!("cannot render: {e}"));
             return;

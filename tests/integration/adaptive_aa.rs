@@ -11,11 +11,18 @@ use glint::render::Renderer;
 use glint::scene::Scene;
 use glint::settings::AntiAliasing;
 
-fn render(scene: &Scene, octree: &Octree, aa: AntiAliasing, w: u32, h: u32) -> (Frame, u64) {
+fn render(
+    scene: &Scene,
+    octree: &std::sync::Arc<Octree>,
+    aa: AntiAliasing,
+    w: u32,
+    h: u32,
+) -> (Frame, u64) {
     let mut settings = scene.render_settings();
     (settings.width, settings.height) = (w, h);
     settings.set_anti_aliasing(aa);
-    let (frame, counts) = Renderer::new(scene, octree, settings)
+    let accel = crate::common::accelerator(scene, &settings, Some(octree));
+    let (frame, counts) = Renderer::new(scene, &accel, settings)
         .unwrap()
         .render(false, None);
     assert_eq!(counts.nonfinite_samples, 0);
@@ -25,7 +32,7 @@ fn render(scene: &Scene, octree: &Octree, aa: AntiAliasing, w: u32, h: u32) -> (
 #[test]
 fn adaptive_pixels_are_either_the_full_grid_or_the_centre() {
     let scene = common::load("scenes/default.toml");
-    let octree = scene.build_octree().unwrap();
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
     let (w, h) = (160, 120);
     let (off, _) = render(&scene, &octree, AntiAliasing::Off, w, h);
     let (full, _) = render(&scene, &octree, AntiAliasing::Full, w, h);
@@ -58,7 +65,7 @@ fn adaptive_is_within_45_db_of_the_full_grid_on_every_scene_kind() {
         "scenes/spd/balls.nff",
     ] {
         let scene = common::load(name);
-        let octree = scene.build_octree().unwrap();
+        let octree = std::sync::Arc::new(scene.build_octree().unwrap());
         let (full, _) = render(&scene, &octree, AntiAliasing::Full, 200, 150);
         let (adaptive, refined) = render(&scene, &octree, AntiAliasing::Adaptive, 200, 150);
         let (off, _) = render(&scene, &octree, AntiAliasing::Off, 200, 150);
@@ -83,15 +90,17 @@ fn adaptive_is_within_45_db_of_the_full_grid_on_every_scene_kind() {
 #[test]
 fn adaptive_is_the_same_with_the_octree_off() {
     let scene = common::load("scenes/glass.toml");
-    let octree = scene.build_octree().unwrap();
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
     let mut settings = scene.render_settings();
     (settings.width, settings.height) = (96, 72);
     settings.set_anti_aliasing(AntiAliasing::Adaptive);
-    let on = Renderer::new(&scene, &octree, settings)
+    let accel = crate::common::accelerator(&scene, &settings, Some(&octree));
+    let on = Renderer::new(&scene, &accel, settings)
         .unwrap()
         .render(false, None);
     settings.accel = Accel::BruteForce;
-    let off = Renderer::new(&scene, &octree, settings)
+    let accel = crate::common::accelerator(&scene, &settings, Some(&octree));
+    let off = Renderer::new(&scene, &accel, settings)
         .unwrap()
         .render(false, None);
     assert_eq!(on.0, off.0);

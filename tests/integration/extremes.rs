@@ -65,7 +65,7 @@ fn transform_quadric(q: &Quadric, s: f64, t: DVec3) -> Quadric {
 }
 
 fn render_scene(scene: &Scene, w: u32, h: u32) -> (Vec<u8>, u64) {
-    let octree = scene.build_octree().unwrap();
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
     let (img, counts) = render_with(scene, &octree, w, h, |s| s.samples = 1);
     (img, counts.nonfinite_samples)
 }
@@ -146,7 +146,7 @@ fn closed_mesh_is_watertight_from_inside() {
             }
         }
     }
-    let octree = Octree::build(&shapes, Default::default()).unwrap();
+    let octree = std::sync::Arc::new(Octree::build(&shapes, Default::default()).unwrap());
     let mut misses = 0;
     for target in &targets {
         let ray = PreparedRay::new(Ray::new(centre, (*target - centre).normalize()));
@@ -257,7 +257,7 @@ fn quadric_extremes() {
 fn total_internal_reflection_at_great_depth_stays_finite() {
     let mut scene = load("scenes/glass.toml");
     scene.image.max_depth = 64;
-    let octree = scene.build_octree().unwrap();
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
     let (_, counts) = render_with(&scene, &octree, 48, 36, |s| s.samples = 1);
     assert_eq!(counts.nonfinite_samples, 0);
     assert!(counts.rays.refraction > 0 && counts.rays.reflection > 0);
@@ -322,7 +322,7 @@ fn extreme_cameras_and_image_shapes_see_what_the_pinhole_predicts() {
         (40.0, 10_000, 1, 2),
     ] {
         let scene = lone_sphere(distance, fov);
-        let octree = scene.build_octree().unwrap();
+        let octree = std::sync::Arc::new(scene.build_octree().unwrap());
         let (inside, border) = sphere_pixels(w, h, fov, distance);
         assert_eq!((inside, border), (expected, 0), "the prediction itself");
         let (_, one) = render_with(&scene, &octree, w, h, |r| r.samples = 1);
@@ -332,7 +332,7 @@ fn extreme_cameras_and_image_shapes_see_what_the_pinhole_predicts() {
         assert_eq!(sixteen.rays.primary, 16 * w as u64 * h as u64);
     }
     let scene = load("scenes/sphere.toml");
-    let octree = scene.build_octree().unwrap();
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
     // Up almost parallel to the view direction still forms a valid basis...
     let mut tilted = scene.clone();
     let view = (scene.camera.lookat - scene.camera.eye).normalize();
@@ -340,7 +340,8 @@ fn extreme_cameras_and_image_shapes_see_what_the_pinhole_predicts() {
     assert!(Camera::new(&tilted.camera, 16, 16).is_ok());
     // ...exactly parallel is a clear error.
     tilted.camera.up = view;
-    let err = Renderer::new(&tilted, &octree, tilted.render_settings())
+    let accel = crate::common::accelerator(&tilted, &tilted.render_settings(), Some(&octree));
+    let err = Renderer::new(&tilted, &accel, tilted.render_settings())
         .err()
         .expect("an error");
     assert!(err.to_string().contains("parallel"), "{err}");
@@ -578,12 +579,13 @@ fn loads_cleanly_or_renders_finite(text: &str, name: &std::path::Path, what: &st
             return Outcome::Refused;
         }
     };
-    let Ok(octree) = scene.build_octree() else {
+    let Ok(octree) = scene.build_octree().map(std::sync::Arc::new) else {
         return Outcome::NotRendered;
     };
     let mut settings = scene.render_settings();
     (settings.width, settings.height, settings.samples) = (16, 12, 1);
-    let Ok(renderer) = Renderer::new(&scene, &octree, settings) else {
+    let accel = crate::common::accelerator(&scene, &settings, Some(&octree));
+    let Ok(renderer) = Renderer::new(&scene, &accel, settings) else {
         return Outcome::NotRendered;
     };
     let (_, counts) = renderer.render(false, None);
@@ -676,7 +678,7 @@ fn a_light_inside_a_surface_casts_no_speckled_shadow() {
     let (open, lit) = (scene(false), scene(true));
     for use_octree in [true, false] {
         let render = |s: &glint::scene::Scene| {
-            let octree = s.build_octree().unwrap();
+            let octree = std::sync::Arc::new(s.build_octree().unwrap());
             render_with(s, &octree, 96, 72, |st| {
                 st.accel = Accel::from_octree_switch(use_octree)
             })

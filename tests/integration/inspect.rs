@@ -152,9 +152,10 @@ fn check_sums(node: &RayNode, scene: &Scene) {
 #[test]
 fn ray_tree_of_a_glass_pixel_has_reflection_and_refraction_and_sums_to_the_pixel() {
     let scene = common::scene_from(MIRROR_AND_GLASS, "test.toml");
-    let octree = scene.build_octree().unwrap();
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
     let s = settings(&scene, ViewMode::Shaded, true);
-    let renderer = Renderer::new(&scene, &octree, s).unwrap();
+    let accel = crate::common::accelerator(&scene, &s, Some(&octree));
+    let renderer = Renderer::new(&scene, &accel, s).unwrap();
     let (frame, _) = renderer.render(false, None);
     let rgb = frame.to_rgb8();
     for (object, kinds) in [
@@ -196,10 +197,11 @@ fn cost_counts_one_test_per_primitive_without_the_octree_and_none_outside_it() {
     );
     let scene = common::scene_from(&text, "test.toml");
     assert_eq!(scene.shapes.len(), 2);
-    let octree = scene.build_octree().unwrap();
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
     let corner = |use_octree| {
         let s = settings(&scene, ViewMode::Cost, use_octree);
-        let (frame, _) = Renderer::new(&scene, &octree, s)
+        let accel = crate::common::accelerator(&scene, &s, Some(&octree));
+        let (frame, _) = Renderer::new(&scene, &accel, s)
             .unwrap()
             .render(false, None);
         (frame.pixels[0], frame)
@@ -218,9 +220,8 @@ fn cost_counts_one_test_per_primitive_without_the_octree_and_none_outside_it() {
     );
     // Summed over the frame, the cost view counts what --stats counts.
     let s = settings(&scene, ViewMode::Shaded, true);
-    let (_, counts) = Renderer::new(&scene, &octree, s)
-        .unwrap()
-        .render(true, None);
+    let accel = crate::common::accelerator(&scene, &s, Some(&octree));
+    let (_, counts) = Renderer::new(&scene, &accel, s).unwrap().render(true, None);
     let total_tests: f64 = frame_on.pixels.iter().map(|p| p.x).sum();
     assert_eq!(total_tests, counts.work.intersection_tests as f64);
     let summary = frame_off.cost_summary().unwrap();
@@ -230,11 +231,12 @@ fn cost_counts_one_test_per_primitive_without_the_octree_and_none_outside_it() {
 #[test]
 fn aa_need_view_agrees_with_the_study_measure() {
     let scene = common::load("scenes/default.toml");
-    let octree = scene.build_octree().unwrap();
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
     let mut s = settings(&scene, ViewMode::AaNeed, true);
     s.width = 96;
     s.height = 72;
-    let (need, _) = Renderer::new(&scene, &octree, s)
+    let accel = crate::common::accelerator(&scene, &s, Some(&octree));
+    let (need, _) = Renderer::new(&scene, &accel, s)
         .unwrap()
         .render(false, None);
     let shaded = |samples| {
@@ -243,7 +245,8 @@ fn aa_need_view_agrees_with_the_study_measure() {
             view: ViewMode::Shaded,
             ..s
         };
-        Renderer::new(&scene, &octree, st)
+        let accel = crate::common::accelerator(&scene, &st, Some(&octree));
+        Renderer::new(&scene, &accel, st)
             .unwrap()
             .render(false, None)
             .0
@@ -513,11 +516,12 @@ fn the_depth_view_has_a_legend() {
         "#,
         "depth.toml",
     );
-    let octree = scene.build_octree().unwrap();
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
     let mut settings = scene.render_settings();
     (settings.width, settings.height) = (41, 41);
     settings.view = glint::settings::ViewMode::Depth;
-    let (frame, _) = glint::render::Renderer::new(&scene, &octree, settings)
+    let accel = crate::common::accelerator(&scene, &settings, Some(&octree));
+    let (frame, _) = glint::render::Renderer::new(&scene, &accel, settings)
         .unwrap()
         .render(false, None);
     let legend = frame.legend().expect("the depth view has a legend");

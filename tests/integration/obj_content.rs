@@ -20,7 +20,7 @@ pub(crate) fn load_file(path: &Path) -> Scene {
 }
 
 pub(crate) fn render(scene: &Scene, w: u32, h: u32, samples: u32) -> Vec<u8> {
-    let octree = scene.build_octree().unwrap();
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
     render_with(scene, &octree, w, h, |s| s.samples = samples).0
 }
 
@@ -292,7 +292,7 @@ fn a_face_listing_its_corners_many_times_is_one_quad() {
     write(dir.path(), "quad.obj", obj.as_bytes());
     let scene = load_file(&dir.path().join("quad.obj"));
     assert_eq!(scene.shapes.len(), 2);
-    let octree = scene.build_octree().unwrap();
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
     assert!(octree.stats().references < 100, "{:?}", octree.stats());
 }
 

@@ -43,15 +43,11 @@ fn octree_on_and_off_and_the_bvh_give_identical_bytes_for_every_scene() {
             "{name}: {differing} pixels differ between octree on and off"
         );
         assert_eq!(c_on.rays, c_off.rays, "{name}: different rays were cast");
-        let bvh = Bvh::build(&scene.shapes);
         let mut settings = scene.render_settings();
         (settings.width, settings.height, settings.samples) = (side, side, 1);
         settings.accel = glint::settings::Accel::Bvh;
-        let light_buffer = scene.build_light_buffer();
-        let renderer = Renderer::new(scene, octree, settings)
-            .unwrap()
-            .with_bvh(&bvh)
-            .with_light_buffer(light_buffer.as_ref());
+        let accel = crate::common::accelerator(scene, &settings, Some(octree));
+        let renderer = Renderer::new(scene, &accel, settings).unwrap();
         // Uncounted: single rays through the BVH's wide walk; counted:
         // through its binary walk.
         let (frame, _) = renderer.render(false, None);
@@ -71,9 +67,8 @@ fn octree_on_and_off_and_the_bvh_give_identical_bytes_for_every_scene() {
             ..settings
         };
         let through = |settings: RenderSettings| {
-            let renderer = Renderer::new(scene, octree, settings)
-                .unwrap()
-                .with_bvh(&bvh);
+            let accel = crate::common::accelerator(scene, &settings, Some(octree));
+            let renderer = Renderer::new(scene, &accel, settings).unwrap();
             renderer.render(false, None).0.to_rgb8()
         };
         let mut octree_full = full;
@@ -145,7 +140,7 @@ proptest! {
         shadow_length in 0.5..20.0f64,
     ) {
         let params = OctreeParams { max_depth, leaf_size, cost_driven: max_depth % 2 == 0, ..Default::default() };
-        let octree = Octree::build(&shapes, params).unwrap();
+        let octree = std::sync::Arc::new(Octree::build(&shapes, params).unwrap());
         let bvh = Bvh::build(&shapes);
         let is_transparent: Vec<bool> = (0..shapes.len()).map(|i| transparent_mask >> (i % 64) & 1 == 1).collect();
         // Some shapes one-sided (the SPD protocol's opaque surfaces).
@@ -171,7 +166,7 @@ proptest! {
         leaf_size in 1u32..6,
         transparent_mask in any::<u64>(),
     ) {
-        let octree = Octree::build(&shapes, OctreeParams { leaf_size, ..Default::default() }).unwrap();
+        let octree = std::sync::Arc::new(Octree::build(&shapes, OctreeParams { leaf_size, ..Default::default() }).unwrap());
         let bvh = Bvh::build(&shapes);
         let is_transparent: Vec<bool> = (0..shapes.len()).map(|i| transparent_mask >> (i % 64) & 1 == 1).collect();
         let prims = Primitives { transparent: &is_transparent, ..Primitives::opaque(&shapes) };
@@ -195,7 +190,7 @@ proptest! {
 /// counts nothing (the wide walk) and by the one that counts (the exact
 /// walk Havran's measures come from), and the BVH's, equal brute force's.
 fn agree(
-    octree: &Octree,
+    octree: &std::sync::Arc<Octree>,
     bvh: &Bvh,
     prims: &Primitives,
     ray: Ray,

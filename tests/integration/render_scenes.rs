@@ -42,7 +42,7 @@ fn output_is_identical_for_any_thread_count() {
         "scenes/spd/teapot.nff",
     ] {
         let scene = load(name);
-        let octree = scene.build_octree().unwrap();
+        let octree = std::sync::Arc::new(scene.build_octree().unwrap());
         let render = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
@@ -94,8 +94,9 @@ fn head_on_plane_matches_the_analytic_colour() {
         color: DVec3::splat(0.5),
     }];
     scene.push(Shape::Plane(Plane::new(DVec3::ZERO, DVec3::Z)), 0);
-    let octree = scene.build_octree().unwrap();
-    let renderer = Renderer::new(&scene, &octree, scene.render_settings()).unwrap();
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
+    let accel = crate::common::accelerator(&scene, &scene.render_settings(), Some(&octree));
+    let renderer = Renderer::new(&scene, &accel, scene.render_settings()).unwrap();
     let (frame, _) = renderer.render(false, None);
     let centre = frame.pixels[4];
     let expected = 0.2 * material.color + (0.6 * material.color + DVec3::splat(0.1)) * 0.5;
@@ -116,7 +117,7 @@ fn head_on_plane_matches_the_analytic_colour() {
 #[test]
 fn quadric_sphere_renders_like_the_analytic_sphere() {
     let mut scene = load("scenes/sphere.toml");
-    let octree = scene.build_octree().unwrap();
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
     let (analytic, _) = render_with(&scene, &octree, 160, 120, |s| s.samples = 16);
     let Shape::Sphere(Sphere {
         center: c,
@@ -140,7 +141,7 @@ fn quadric_sphere_renders_like_the_analytic_sphere() {
         ],
         None,
     )));
-    let octree = scene.build_octree().unwrap();
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
     let (quadric, _) = render_with(&scene, &octree, 160, 120, |s| s.samples = 16);
     let (over_one, largest) = diff(&analytic, &quadric, 0);
     let (over_two, _) = diff(&analytic, &quadric, 2);
@@ -157,7 +158,7 @@ fn quadric_sphere_renders_like_the_analytic_sphere() {
 fn sixteen_samples_differ_from_one_only_near_edges() {
     for name in ["scenes/sphere.toml", "scenes/quadrics.toml"] {
         let scene = load(name);
-        let octree = scene.build_octree().unwrap();
+        let octree = std::sync::Arc::new(scene.build_octree().unwrap());
         let (w, h) = (120u32, 90u32);
         let (one, _) = render_with(&scene, &octree, w, h, |s| s.samples = 1);
         let (sixteen, _) = render_with(&scene, &octree, w, h, |s| s.samples = 16);
@@ -199,7 +200,7 @@ fn sixteen_samples_differ_from_one_only_near_edges() {
 #[test]
 fn normals_and_depth_views_are_as_documented() {
     let scene = load("scenes/sphere.toml");
-    let octree = scene.build_octree().unwrap();
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
     let (w, h) = (81u32, 61u32);
     let (normals, _) = render_with(&scene, &octree, w, h, |s| {
         s.samples = 1;

@@ -53,10 +53,11 @@ fn assert_exact_coverage(polygon: &[DVec3], eye: DVec3, size: u32) {
     let text = nff_with_polygon(eye, polygon, size);
     let scene = scene_from(&text, "polygon.nff");
     assert_eq!(scene.dropped_polygons.total(), 0, "the polygon is simple");
-    let octree = scene.build_octree().unwrap();
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
     let mut settings = scene.render_settings();
     settings.view = ViewMode::Depth;
-    let renderer = Renderer::new(&scene, &octree, settings).unwrap();
+    let accel = crate::common::accelerator(&scene, &settings, Some(&octree));
+    let renderer = Renderer::new(&scene, &accel, settings).unwrap();
     let (frame, _) = renderer.render(false, None);
     let camera = Camera::new(&scene.camera, size, size).unwrap();
     let (mut covered, mut skipped, mut wrong) = (0, 0, Vec::new());
@@ -322,7 +323,9 @@ fn through_one_point(n: usize) -> String {
 fn assert_bounded_and_exact(name: &str, text: &str, params: OctreeParams) {
     let mut scene = scene_from(text, &format!("{name}.nff"));
     scene.octree_params = params;
-    let octree = Octree::build(&scene.shapes, params).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let octree = std::sync::Arc::new(
+        Octree::build(&scene.shapes, params).unwrap_or_else(|e| panic!("{name}: {e}")),
+    );
     let stats = octree.stats();
     assert!(
         stats.memory_bytes <= stats.memory_budget_bytes,
@@ -367,7 +370,8 @@ fn torture_scenes_build_within_budget_and_render_like_brute_force() {
         // The BVH on the same scenes: the same pixels, one reference per
         // shape, and a depth the median splits keep logarithmic.
         let scene = scene_from(text, &format!("{name}.nff"));
-        let octree = Octree::build(&scene.shapes, OctreeParams::default()).unwrap();
+        let octree =
+            std::sync::Arc::new(Octree::build(&scene.shapes, OctreeParams::default()).unwrap());
         let bvh = glint::accel::Bvh::build(&scene.shapes);
         let stats = bvh.stats();
         assert!(stats.references <= scene.shapes.len() as u64, "{name}");
@@ -380,9 +384,8 @@ fn torture_scenes_build_within_budget_and_render_like_brute_force() {
         let mut settings = scene.render_settings();
         (settings.width, settings.height) = (40, 40);
         settings.accel = glint::settings::Accel::Bvh;
-        let renderer = glint::render::Renderer::new(&scene, &octree, settings)
-            .unwrap()
-            .with_bvh(&bvh);
+        let accel = crate::common::accelerator(&scene, &settings, Some(&octree));
+        let renderer = glint::render::Renderer::new(&scene, &accel, settings).unwrap();
         let through_bvh = renderer.render(false, None).0.to_rgb8();
         assert!(
             through_bvh == brute,
@@ -401,7 +404,7 @@ fn coincident_triangles_stop_splitting_instead_of_multiplying() {
         cost_driven: false,
         ..OctreeParams::default()
     };
-    let octree = Octree::build(&scene.shapes, params).unwrap();
+    let octree = std::sync::Arc::new(Octree::build(&scene.shapes, params).unwrap());
     let stats = octree.stats();
     eprintln!("coincident triangles: {stats:?}");
     // Inside the triangle, a split only copies every reference into each
@@ -547,10 +550,11 @@ fn through(glass: &str, light_x: f64) -> f64 {
          f 1 1 1 0.1 0 1 0.9 1.5\n{glass}"
     );
     let scene = scene_from(&text, "glass.nff");
-    let octree = scene.build_octree().unwrap();
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
     let mut settings = scene.render_settings();
     settings.max_depth = 1;
-    let renderer = Renderer::new(&scene, &octree, settings).unwrap();
+    let accel = crate::common::accelerator(&scene, &settings, Some(&octree));
+    let renderer = Renderer::new(&scene, &accel, settings).unwrap();
     let tree = renderer.ray_tree(4, 4);
     let hit = tree.hit.as_ref().expect("the eye ray hits the floor");
     assert!((hit.point[2] + 3.0).abs() < 1e-9, "{:?}", hit.point);
@@ -637,10 +641,11 @@ fn records_of_large_scenes_keep_standard_text_chunks_small() {
     let path = repo_path("scenes/spd/gears.nff");
     let scene = glint::scene::load(&path).unwrap();
     assert!(scene.source_text.len() > 1 << 20);
-    let octree = scene.build_octree().unwrap();
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
     let mut settings = scene.render_settings();
     (settings.width, settings.height) = (8, 8);
-    let renderer = Renderer::new(&scene, &octree, settings).unwrap();
+    let accel = crate::common::accelerator(&scene, &settings, Some(&octree));
+    let renderer = Renderer::new(&scene, &accel, settings).unwrap();
     let (frame, _) = renderer.render(false, None);
     let record = glint::export::RenderRecord::new(
         &scene,

@@ -31,14 +31,15 @@ fn packet_levels() -> Vec<SimdLevel> {
 /// Renders at every level and asserts each equals the scalar render.
 fn assert_levels_agree(
     scene: &Scene,
-    octree: &Octree,
+    octree: &std::sync::Arc<Octree>,
     label: &str,
     adjust: impl Fn(&mut RenderSettings),
 ) {
     let render = |level: SimdLevel| {
         let mut settings = scene.render_settings();
         adjust(&mut settings);
-        let renderer = Renderer::new(scene, octree, settings)
+        let accel = crate::common::accelerator(scene, &settings, Some(octree));
+        let renderer = Renderer::new(scene, &accel, settings)
             .unwrap()
             .with_simd(level);
         assert_eq!(renderer.simd(), level);
@@ -93,7 +94,7 @@ fn views_octree_off_and_adaptive_agree_at_every_level() {
         "scenes/quadrics.toml",
     ] {
         let scene = load(name);
-        let octree = scene.build_octree().unwrap();
+        let octree = std::sync::Arc::new(scene.build_octree().unwrap());
         for view in [ViewMode::Normals, ViewMode::Depth, ViewMode::AaNeed] {
             assert_levels_agree(&scene, &octree, &format!("{name} {view:?}"), |s| {
                 s.width = 33;
@@ -169,7 +170,7 @@ proptest! {
     #[test]
     fn random_soups_render_the_same_bytes_at_every_level(text in soup_strategy()) {
         let scene = scene_from(&text, "soup.toml");
-        let octree = scene.build_octree().unwrap();
+        let octree = std::sync::Arc::new(scene.build_octree().unwrap());
         assert_levels_agree(&scene, &octree, &text, |_| {});
         assert_levels_agree(&scene, &octree, &text, |s| s.samples = 16);
     }

@@ -53,13 +53,14 @@ fn corner_distance(ci: u32, cj: u32, w: u32, h: u32) -> f64 {
 #[test]
 fn corner_rays_make_each_pixel_the_mean_of_its_four_corners() {
     let scene = scene_from(TILTED_PLANE, "tilted.toml");
-    let octree = scene.build_octree().unwrap();
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
     let mut settings = spd(&scene);
     settings.view = ViewMode::Depth;
     // Three bands of corner rows, the last one partial.
     (settings.width, settings.height) = (8, 37);
     let (w, h) = (settings.width, settings.height);
-    let renderer = Renderer::new(&scene, &octree, settings).unwrap();
+    let accel = crate::common::accelerator(&scene, &settings, Some(&octree));
+    let renderer = Renderer::new(&scene, &accel, settings).unwrap();
     let (frame, counts) = renderer.render(false, None);
     assert_eq!(counts.rays.primary, ((w + 1) * (h + 1)) as u64);
     assert_eq!(counts.rays.primary_hits, counts.rays.primary);
@@ -124,11 +125,12 @@ impl glint::render::PassWatch for BandCollector {
 #[test]
 fn a_512_square_image_casts_513_squared_eye_rays_in_any_row_subset() {
     let scene = scene_from(TILTED_PLANE, "tilted.toml");
-    let octree = scene.build_octree().unwrap();
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
     let mut settings = spd(&scene);
     (settings.width, settings.height) = (512, 512);
     settings.view = ViewMode::Depth;
-    let renderer = Renderer::new(&scene, &octree, settings).unwrap();
+    let accel = crate::common::accelerator(&scene, &settings, Some(&octree));
+    let renderer = Renderer::new(&scene, &accel, settings).unwrap();
     let (_, counts) = renderer.render(false, None);
     assert_eq!(counts.rays.primary, 513 * 513);
     // Every 4th row (as `glint bench` samples brute force): the top edge
@@ -145,8 +147,9 @@ fn nff(light: &str, body: &str) -> String {
 }
 
 fn tree_at(scene: &Scene, settings: RenderSettings, i: u32, j: u32) -> RayNode {
-    let octree = scene.build_octree().unwrap();
-    Renderer::new(scene, &octree, settings)
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
+    let accel = crate::common::accelerator(scene, &settings, Some(&octree));
+    Renderer::new(scene, &accel, settings)
         .unwrap()
         .ray_tree(i, j)
 }
@@ -183,9 +186,10 @@ fn a_light_behind_the_surface_gets_no_shadow_ray() {
     // A wall facing the camera, the light behind it.
     let wall = "f 1 1 1 0.8 0 1 0 0\np 4\n-9 -9 0\n9 -9 0\n9 9 0\n-9 9 0\n";
     let scene = scene_from(&nff("0 0 -5", wall), "wall.nff");
-    let octree = scene.build_octree().unwrap();
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
     for settings in [scene.render_settings(), spd(&scene)] {
-        let renderer = Renderer::new(&scene, &octree, settings).unwrap();
+        let accel = crate::common::accelerator(&scene, &settings, Some(&octree));
+        let renderer = Renderer::new(&scene, &accel, settings).unwrap();
         let (_, counts) = renderer.render(false, None);
         assert_eq!(counts.rays.primary_hits, counts.rays.primary);
         assert_eq!(counts.rays.shadow, 0, "{:?}", settings.protocol);
@@ -194,8 +198,9 @@ fn a_light_behind_the_surface_gets_no_shadow_ray() {
     }
     // With the light in front, every hit casts one.
     let lit = scene_from(&nff("0 0 5", wall), "wall.nff");
-    let octree = lit.build_octree().unwrap();
-    let (_, counts) = Renderer::new(&lit, &octree, spd(&lit))
+    let octree = std::sync::Arc::new(lit.build_octree().unwrap());
+    let accel = crate::common::accelerator(&lit, &spd(&lit), Some(&octree));
+    let (_, counts) = Renderer::new(&lit, &accel, spd(&lit))
         .unwrap()
         .render(false, None);
     assert_eq!(counts.rays.shadow, 36);
@@ -230,10 +235,11 @@ fn total_internal_reflection_casts_no_refraction_ray_and_is_counted() {
     let text = "v\nfrom 0.9 -0.2 0\nat 0.9 1 0\nup 0 0 1\nangle 1\nhither 1\nresolution 1 1\n\
                 l 0 0 9\nf 1 1 1 0.1 0 1 0.9 1.5\ns 0 0 0 1\n";
     let scene = scene_from(text, "inside.nff");
-    let octree = scene.build_octree().unwrap();
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
     let mut settings = scene.render_settings().with_protocol(Protocol::Spd);
     settings.max_depth = 2;
-    let renderer = Renderer::new(&scene, &octree, settings).unwrap();
+    let accel = crate::common::accelerator(&scene, &settings, Some(&octree));
+    let renderer = Renderer::new(&scene, &accel, settings).unwrap();
     let (_, counts) = renderer.render(false, None);
     // Four corner rays, each totally reflected: four reflection rays.
     assert_eq!(counts.rays.primary, 4);
@@ -258,8 +264,9 @@ const PUBLISHED: [(&str, [u64; 4]); 7] = [
 fn published_ray_counts_are_reproduced_within_ten_percent() {
     for (name, published) in PUBLISHED {
         let scene = glint::scene::load(&repo_path(&format!("scenes/spd/{name}.nff"))).unwrap();
-        let octree = scene.build_octree().unwrap();
-        let renderer = Renderer::new(&scene, &octree, spd(&scene)).unwrap();
+        let octree = std::sync::Arc::new(scene.build_octree().unwrap());
+        let accel = crate::common::accelerator(&scene, &spd(&scene), Some(&octree));
+        let renderer = Renderer::new(&scene, &accel, spd(&scene)).unwrap();
         let (_, counts) = renderer.render(false, None);
         let r = counts.rays;
         assert_eq!(r.primary, 513 * 513);
@@ -297,14 +304,15 @@ fn display_values_are_shaded_and_written_unchanged() {
                 p 4\n-9 -9 0\n9 -9 0\n9 9 0\n-9 9 0\n";
     let scene = scene_from(text, "plane.nff");
     assert_eq!(scene.image.colors, ColorConvention::Display);
-    let octree = scene.build_octree().unwrap();
+    let octree = std::sync::Arc::new(scene.build_octree().unwrap());
     let color = DVec3::new(0.5, 0.25, 0.125);
     // One light: the ambient is sqrt(1) / 2; NFF weights it by Kd.
     let ambient = 0.5 * 0.6;
     let expected = ambient * color + (0.6 * color + DVec3::splat(0.1)) * 0.5;
     let mut settings = scene.render_settings();
     settings.max_depth = 1;
-    let (frame, _) = Renderer::new(&scene, &octree, settings)
+    let accel = crate::common::accelerator(&scene, &settings, Some(&octree));
+    let (frame, _) = Renderer::new(&scene, &accel, settings)
         .unwrap()
         .render(false, None);
     let centre = frame.pixels[4];
@@ -318,7 +326,8 @@ fn display_values_are_shaded_and_written_unchanged() {
     // The same file in linear light: the colour is decoded from sRGB first,
     // the result encoded again.
     settings.colors = ColorConvention::Linear;
-    let (linear, _) = Renderer::new(&scene, &octree, settings)
+    let accel = crate::common::accelerator(&scene, &settings, Some(&octree));
+    let (linear, _) = Renderer::new(&scene, &accel, settings)
         .unwrap()
         .render(false, None);
     let decoded = DVec3::new(0.5, 0.25, 0.125).map(glint::color::srgb_to_linear);

@@ -517,7 +517,8 @@ fn a_budget_preview_drops_what_it_says() {
     let mut settings = scene.render_settings();
     (settings.width, settings.height, settings.max_depth) = (48, 36, 2);
     settings.set_anti_aliasing(AntiAliasing::Off);
-    let (frame, counts) = Renderer::new(&scene, &octree, settings)
+    let accel = crate::common::accelerator(&scene, &settings, Some(&octree));
+    let (frame, counts) = Renderer::new(&scene, &accel, settings)
         .unwrap()
         .render(false, None);
     assert!(counts.rays.refraction > 0, "the scene has glass");

@@ -66,7 +66,8 @@ fn each_plan_shows_its_passes_and_ends_on_the_cli_frame() {
             .collect();
         let kinds: Vec<ShownPass> = passes.iter().map(|r| r.kind).collect();
         assert_eq!(kinds, expected, "{scene_file}");
-        let (frame, counts) = Renderer::new(&scene, &octree, settings)
+        let accel = crate::common::accelerator(&scene, &settings, Some(&octree));
+        let (frame, counts) = Renderer::new(&scene, &accel, settings)
             .unwrap()
             .render(false, None);
         let last = passes.last().unwrap();
@@ -120,7 +121,8 @@ fn render_cache_previews_fill_the_image_and_the_passes_still_end_on_the_cli_fram
     let mut settings = moving.settings;
     settings.set_anti_aliasing(AntiAliasing::Off);
     let exact = |camera: &glint::camera::CameraSpec| {
-        Renderer::with_camera(&scene, &octree, settings, camera)
+        let accel = crate::common::accelerator(&scene, &settings, Some(&octree));
+        Renderer::with_camera(&scene, &accel, settings, camera)
             .unwrap()
             .render(false, None)
             .0

@@ -63,9 +63,11 @@ fn counts(q: &QueryRecord) -> WorkCounts {
 fn walks_go_front_to_back_and_find_what_the_ray_and_brute_force_find() {
     for path in SCENES {
         let scene = common::load(path);
-        let octree = scene.build_octree().unwrap();
-        let on = Renderer::new(&scene, &octree, settings(&scene, true)).unwrap();
-        let off = Renderer::new(&scene, &octree, settings(&scene, false)).unwrap();
+        let octree = std::sync::Arc::new(scene.build_octree().unwrap());
+        let accel = crate::common::accelerator(&scene, &settings(&scene, true), Some(&octree));
+        let on = Renderer::new(&scene, &accel, settings(&scene, true)).unwrap();
+        let accel = crate::common::accelerator(&scene, &settings(&scene, false), Some(&octree));
+        let off = Renderer::new(&scene, &accel, settings(&scene, false)).unwrap();
         let (mut leaves, mut empties, mut blocked) = (0, 0, 0);
         for j in (0..SIZE.1).step_by(3) {
             for i in (0..SIZE.0).step_by(3) {
@@ -188,9 +190,14 @@ fn the_walks_of_every_pixel_sum_to_the_renders_havran_counts() {
     for level in levels {
         for path in SCENES {
             let scene = common::load(path);
-            let octree = scene.build_octree().unwrap();
+            let octree = std::sync::Arc::new(scene.build_octree().unwrap());
             for use_octree in [true, false] {
-                let renderer = Renderer::new(&scene, &octree, settings(&scene, use_octree))
+                let accel = crate::common::accelerator(
+                    &scene,
+                    &settings(&scene, use_octree),
+                    Some(&octree),
+                );
+                let renderer = Renderer::new(&scene, &accel, settings(&scene, use_octree))
                     .unwrap()
                     .with_simd(level);
                 let (_, rendered) = renderer.render(true, None);

@@ -73,6 +73,7 @@ impl Bvh {
         }
         let mut bvh = Bvh {
             unbounded,
+            planes: crate::accel::planes::PlaneGroups::build(shapes),
             ..Bvh::default()
         };
         if !items.is_empty() {

@@ -14,6 +14,8 @@ pub struct Bvh {
     pub(super) stats: BvhStats,
     /// The same tree in eight-wide nodes, for uncounted queries.
     pub(super) wide: WideNodes,
+    /// The shapes grouped by the plane they lie in, for rays leaving one.
+    pub(super) planes: crate::accel::planes::PlaneGroups,
 }
 
 /// What the build made, for the statistics a user compares with the
@@ -33,6 +35,11 @@ pub struct BvhStats {
 impl Bvh {
     pub fn stats(&self) -> BvhStats {
         self.stats
+    }
+
+    /// The shapes grouped by the plane they lie in.
+    pub fn planes(&self) -> &crate::accel::planes::PlaneGroups {
+        &self.planes
     }
 
     /// Whether the uncounted queries can take the wide walk.

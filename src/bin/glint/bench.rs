@@ -2,11 +2,12 @@
 
 use glint::settings::Accel;
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Result, bail};
 use glint::accel::{Octree, OctreeStats};
-use glint::render::{Prediction, Renderer, UnitCosts};
+use glint::render::{Accelerator, LightBufferSource, Prediction, Renderer, Reuse, UnitCosts};
 use glint::report::{SceneBench, duration_text};
 use glint::settings::{Overrides, RenderSettings};
 use serde::Serialize;
@@ -342,14 +343,22 @@ fn sweep(args: &BenchArgs) -> Result<()> {
         // Every setting's shadow rays ask the same light buffer first, as
         // a render's do: the sweep varies only the tree.
         // (A one-leaf tree's renderer ignores it.)
-        let light_buffer = pool.install(|| scene.build_light_buffer());
+        let light_buffer = pool.install(|| scene.build_light_buffer()).map(Arc::new);
+        let through = |octree: &Arc<Octree>| {
+            let reuse = Reuse {
+                octree: Some(Arc::clone(octree)),
+                bvh: None,
+                light_buffer: LightBufferSource::Given(light_buffer.clone()),
+            };
+            Accelerator::build(&scene, &settings, reuse)
+        };
         // Unit costs once per scene, on its own octree setting, and how
         // the time per ray changes with the image's size (the scene's and
         // view's, as "Suggest a setting" takes it).
         let (unit_costs, per_doubling) = {
-            let octree = pool.install(|| scene.build_octree())?;
-            let renderer =
-                Renderer::new(&scene, &octree, settings)?.with_light_buffer(light_buffer.as_ref());
+            let octree = Arc::new(pool.install(|| scene.build_octree())?);
+            let accel = through(&octree)?;
+            let renderer = Renderer::new(&scene, &accel, settings)?;
             let sample = glint::render::sample_rays(&renderer, &octree)?;
             (
                 UnitCosts::measure(&renderer, &octree)?,
@@ -405,14 +414,14 @@ fn sweep(args: &BenchArgs) -> Result<()> {
                 builds.push(s);
                 tree = Some(t?);
             }
-            let Some(octree) = tree else {
+            let Some(octree) = tree.map(Arc::new) else {
                 bail!("no repeats")
             };
             // The prediction comes first: it needs the tree, not the render
             // (the ray count, which the octree does not change, excepted).
             let predicted_cost = octree.predicted_cost();
-            let renderer =
-                Renderer::new(&scene, &octree, settings)?.with_light_buffer(light_buffer.as_ref());
+            let accel = through(&octree)?;
+            let renderer = Renderer::new(&scene, &accel, settings)?;
             let ray_sample = glint::render::sample_rays_with(&renderer, &octree, per_doubling)?;
             let counts = pool.install(|| renderer.render(true, None).1);
             for _ in 0..args.repeat {

@@ -5,9 +5,14 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use glint::accel::{Bvh, Octree};
+use std::sync::Arc;
+
+use glint::accel::Octree;
 use glint::camera::CameraSpec;
-use glint::render::{FinishedTile, PassInfo, PassOptions, PassWatch, RenderedFrame, Renderer};
+use glint::render::{
+    Accelerator, FinishedTile, LightBufferSource, PassInfo, PassOptions, PassWatch, RenderedFrame,
+    Renderer, Reuse,
+};
 use glint::settings::{Accel, Overrides, RenderSettings, ViewMode};
 
 use crate::common::{
@@ -117,12 +122,11 @@ pub(crate) struct Prepared {
     pub(crate) scene_name: String,
     pub(crate) settings: RenderSettings,
     pub(crate) camera: CameraSpec,
-    pub(crate) octree: Octree,
-    /// Built with `--accel bvh`: then it answers every query.
-    bvh: Option<glint::accel::Bvh>,
-    /// Built when shadow rays go through an accelerator (it answers
-    /// theirs first), with the seconds it took.
-    light_buffer: Option<(glint::accel::LightBuffer, f64)>,
+    /// What every query goes through, as the settings choose.
+    pub(crate) accel: Accelerator,
+    /// The octree `--overlay octree` draws: the accelerator's, or one
+    /// built for the overlay alone.
+    overlay_octree: Option<Arc<Octree>>,
     overlay_depth: Option<u32>,
     legend: bool,
     /// The frame of a sequence a `--from-png` record says it renders.
@@ -130,7 +134,9 @@ pub(crate) struct Prepared {
     threads: usize,
     pub(crate) pool: rayon::ThreadPool,
     pub(crate) load_s: f64,
+    /// Seconds to build the structure and the light buffer.
     pub(crate) build_s: f64,
+    light_buffer_s: f64,
 }
 
 impl Prepared {
@@ -148,12 +154,7 @@ impl Prepared {
         settings: RenderSettings,
         camera: &CameraSpec,
     ) -> Result<Renderer<'_>, glint::render::RenderError> {
-        let renderer = Renderer::with_camera(&self.scene, &self.octree, settings, camera)?
-            .with_light_buffer(self.light_buffer.as_ref().map(|(b, _)| b));
-        Ok(match &self.bvh {
-            Some(bvh) => renderer.with_bvh(bvh),
-            None => renderer,
-        })
+        Renderer::with_camera(&self.scene, &self.accel, settings, camera)
     }
 }
 
@@ -258,40 +259,39 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
     overrides.apply(&mut settings, &mut scene.octree_params);
 
     let threads = pool.current_num_threads();
-    let build_start = Instant::now();
     // A depth with no overlay to draw would be ignored without a word.
     anyhow::ensure!(
         args.overlay_depth.is_none() || overlay_depth.is_some(),
         "--overlay-depth sets how deep the octree overlay draws: add --overlay octree \
          (or render again a PNG that recorded an overlay, with --from-png)"
     );
-    let octree = if settings.accel == Accel::Octree || overlay_depth.is_some() {
-        pool.install(|| scene.build_octree())
-            .with_context(|| format!("cannot build the octree of {scene_name}"))?
-    } else {
-        Octree::build(&[], scene.octree_params)?
-    };
-    let bvh = (settings.accel == Accel::Bvh).then(|| pool.install(|| Bvh::build(&scene.shapes)));
-    let build_s = build_start.elapsed().as_secs_f64();
-    // `--stats` renders counting the accelerator's work, which the
+    // `--stats` renders counting the accelerator's work, which the light
     // buffer would hide: there it is not built.
-    let light_buffer = (Renderer::wants_light_buffer(&scene, &settings, &octree) && !args.stats)
-        .then(|| {
-            let start = Instant::now();
-            let built = pool.install(|| scene.build_light_buffer())?;
-            Some((built, start.elapsed().as_secs_f64()))
-        })
-        .flatten();
+    let reuse = Reuse {
+        light_buffer: if args.stats {
+            LightBufferSource::Given(None)
+        } else {
+            LightBufferSource::Build
+        },
+        ..Reuse::default()
+    };
+    let accel = pool
+        .install(|| Accelerator::build(&scene, &settings, reuse))
+        .with_context(|| format!("cannot build the octree of {scene_name}"))?;
+    let overlay_octree = match (overlay_depth, accel.octree()) {
+        (None, _) => None,
+        (Some(_), Some(tree)) => Some(Arc::clone(tree)),
+        (Some(_), None) => Some(Arc::new(
+            pool.install(|| scene.build_octree())
+                .with_context(|| format!("cannot build the octree of {scene_name}"))?,
+        )),
+    };
+    let (structure_s, light_buffer_s) = accel.build_seconds();
     if args.output.is_some() {
         // Validate before starting.
-        Renderer::with_camera(&scene, &octree, settings, &camera)
+        Renderer::with_camera(&scene, &accel, settings, &camera)
             .with_context(|| format!("cannot render {scene_name}"))?;
-        let accel_bytes = octree.stats().memory_bytes
-            + bvh.as_ref().map_or(0, |b| b.stats().memory_bytes)
-            + light_buffer
-                .as_ref()
-                .map_or(0, |(b, _)| b.stats().memory_bytes);
-        glint::render::memory::check_memory(&settings, accel_bytes)
+        glint::render::memory::check_memory(&settings, accel.memory_bytes())
             .with_context(|| format!("cannot render {scene_name}"))?;
     }
     Ok(Prepared {
@@ -299,16 +299,16 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
         scene_name,
         settings,
         camera,
-        octree,
-        bvh,
-        light_buffer,
+        accel,
+        overlay_octree,
         overlay_depth,
         legend,
         frame,
         threads,
         pool,
         load_s,
-        build_s,
+        build_s: structure_s,
+        light_buffer_s,
     })
 }
 
@@ -407,8 +407,9 @@ pub(crate) fn save_from(
     let camera = glint::camera::Camera::new(camera_spec, s.width, s.height)?;
     let overlay = job
         .overlay_depth
-        .map(|depth| glint::export::OverlayRequest {
-            octree: &job.octree,
+        .zip(job.overlay_octree.as_deref())
+        .map(|(depth, octree)| glint::export::OverlayRequest {
+            octree,
             camera: &camera,
             depth,
         });
@@ -425,7 +426,7 @@ fn report(
     output: &std::path::Path,
     (render_s, write_s): (f64, f64),
 ) -> Result<()> {
-    let (scene, settings, octree) = (&job.scene, &job.settings, &job.octree);
+    let (scene, settings) = (&job.scene, &job.settings);
     let (frame, counts) = (&rendered.frame, &rendered.counts);
     if !args.quiet {
         // The file's own size: cost views add their legend under the image.
@@ -441,14 +442,14 @@ fn report(
             }
             _ => String::new(),
         };
-        let light_buffer_s = job.light_buffer.as_ref().map_or(0.0, |(_, s)| *s);
-        let light_buffer_note = if job.light_buffer.is_some() {
+        let light_buffer_s = job.light_buffer_s;
+        let light_buffer_note = if job.accel.light_buffer().is_some() {
             format!("; light buffer {light_buffer_s:.3} s")
         } else {
             String::new()
         };
         say!(
-            "wrote {} ({}x{}{written}) in {:.2} s: load {:.2} s, {} build {:.2} s, render {:.2} s, write {:.2} s{light_buffer_note}",
+            "wrote {} ({}x{}{written}) in {:.2} s: load {:.2} s, {}, render {:.2} s, write {:.2} s{light_buffer_note}",
             if output.as_os_str() == "-" {
                 "standard output".to_string()
             } else {
@@ -458,8 +459,11 @@ fn report(
             height,
             job.load_s + job.build_s + light_buffer_s + render_s + write_s,
             job.load_s,
-            if job.bvh.is_some() { "BVH" } else { "octree" },
-            job.build_s,
+            match job.accel.kind() {
+                Accel::Octree => format!("octree build {:.2} s", job.build_s),
+                Accel::Bvh => format!("BVH build {:.2} s", job.build_s),
+                Accel::BruteForce => "no accelerator (brute force)".to_string(),
+            },
             render_s,
             write_s
         );
@@ -473,7 +477,9 @@ fn report(
              looks away from the scene, or the scene is far smaller or larger than its view)"
         );
     }
-    if octree.stats().leaves_stopped_by_budget > 0 {
+    if let Some(octree) = job.accel.octree()
+        && octree.stats().leaves_stopped_by_budget > 0
+    {
         say!(
             "note: the octree build reached its memory budget of {} MiB (nodes, references and \
              the cells still to split, held at once while building; the finished tree takes {:.1} MiB): \
@@ -496,14 +502,10 @@ fn report(
         scene,
         settings,
         job.threads,
-        octree,
+        &job.accel,
         rendered,
         times,
     );
-    let stats = match &job.bvh {
-        Some(bvh) => stats.with_bvh(bvh.stats()),
-        None => stats,
-    };
     out!("{}", serde_json::to_string_pretty(&stats)?)?;
     Ok(())
 }

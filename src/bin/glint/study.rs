@@ -8,6 +8,7 @@
 use glint::settings::Accel;
 use std::fmt::Write as _;
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
@@ -15,7 +16,7 @@ use glint::accel::{Octree, OctreeParams};
 use glint::image::frame::Frame;
 use glint::image::metrics::image_error;
 use glint::math::DVec3;
-use glint::render::Renderer;
+use glint::render::{Accelerator, LightBufferSource, Renderer, Reuse};
 use glint::scene::Scene;
 use glint::settings::RenderSettings;
 
@@ -44,9 +45,9 @@ pub struct StudyArgs {
 
 struct Study<'a> {
     scene: &'a Scene,
-    octree: Octree,
+    octree: Arc<Octree>,
     /// Asked first by every timed render's shadow rays, as in a release render.
-    light_buffer: Option<glint::accel::LightBuffer>,
+    light_buffer: Option<Arc<glint::accel::LightBuffer>>,
 
     repeat: u32,
     pool: rayon::ThreadPool,
@@ -54,7 +55,7 @@ struct Study<'a> {
 
 impl Study<'_> {
     /// Median time and the frame of a render with `settings`.
-    fn run(&self, settings: RenderSettings, octree: Option<&Octree>) -> Result<(f64, Frame)> {
+    fn run(&self, settings: RenderSettings, octree: Option<&Arc<Octree>>) -> Result<(f64, Frame)> {
         self.run_times(settings, octree, self.repeat)
     }
 
@@ -66,12 +67,16 @@ impl Study<'_> {
     fn run_times(
         &self,
         settings: RenderSettings,
-        octree: Option<&Octree>,
+        octree: Option<&Arc<Octree>>,
         repeat: u32,
     ) -> Result<(f64, Frame)> {
-        let octree = octree.unwrap_or(&self.octree);
-        let renderer = Renderer::new(self.scene, octree, settings)?
-            .with_light_buffer(self.light_buffer.as_ref());
+        let reuse = Reuse {
+            octree: Some(Arc::clone(octree.unwrap_or(&self.octree))),
+            bvh: None,
+            light_buffer: LightBufferSource::Given(self.light_buffer.clone()),
+        };
+        let accel = Accelerator::build(self.scene, &settings, reuse)?;
+        let renderer = Renderer::new(self.scene, &accel, settings)?;
         let mut times = Vec::new();
         let mut frame = None;
         for _ in 0..repeat.max(1) {
@@ -147,8 +152,8 @@ pub fn run(args: &StudyArgs) -> Result<()> {
         (base.width, base.height) = (w, h);
         base.accel = Accel::Octree;
         let study = Study {
-            octree: scene.build_octree()?,
-            light_buffer: scene.build_light_buffer(),
+            octree: Arc::new(scene.build_octree()?),
+            light_buffer: scene.build_light_buffer().map(Arc::new),
             scene: &scene,
             repeat: args.repeat,
             pool: thread_pool(args.threads)?,
@@ -227,7 +232,9 @@ pub fn run(args: &StudyArgs) -> Result<()> {
         };
         let (t_adaptive, f_adaptive) = study.run(adaptive, None)?;
         let refined = {
-            let renderer = Renderer::new(study.scene, &study.octree, adaptive)?;
+            let accel =
+                Accelerator::build(study.scene, &adaptive, Reuse::octree_alone(&study.octree))?;
+            let renderer = Renderer::new(study.scene, &accel, adaptive)?;
             study
                 .pool
                 .install(|| renderer.render(false, None).1)
@@ -317,12 +324,16 @@ pub fn run(args: &StudyArgs) -> Result<()> {
                     ..scene.octree_params
                 };
                 let start = Instant::now();
-                let tree = study
-                    .pool
-                    .install(|| Octree::build(&scene.shapes, params))?;
+                let tree = Arc::new(
+                    study
+                        .pool
+                        .install(|| Octree::build(&scene.shapes, params))?,
+                );
                 let build = start.elapsed().as_secs_f64();
                 let (t, _) = study.run(RenderSettings { samples: 1, ..base }, Some(&tree))?;
-                let renderer = Renderer::new(&scene, &tree, RenderSettings { samples: 1, ..base })?;
+                let counted = RenderSettings { samples: 1, ..base };
+                let accel = Accelerator::build(&scene, &counted, Reuse::octree_alone(&tree))?;
+                let renderer = Renderer::new(&scene, &accel, counted)?;
                 let counts = study.pool.install(|| renderer.render(true, None).1);
                 writeln!(
                     md,

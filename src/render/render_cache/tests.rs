@@ -78,8 +78,8 @@ fn turned(s: &Scene, degrees: f64) -> CameraSpec {
 
 /// The 1-sample picture of `s` from `camera`, RGBA8 as shown.
 fn exact(s: &Scene, camera: &CameraSpec) -> Vec<u8> {
-    let octree = s.build_octree().unwrap();
-    let r = Renderer::with_camera(s, &octree, s.render_settings(), camera).unwrap();
+    let accel = crate::render::Accelerator::of_octree(s, s.build_octree().unwrap());
+    let r = Renderer::with_camera(s, &accel, s.render_settings(), camera).unwrap();
     let (frame, _) = r.render(false, None);
     crate::image::frame::rgb_to_rgba(&frame.to_rgb8())
 }
@@ -167,9 +167,9 @@ fn show(
 /// A cache seeded from the exact picture at `s`'s camera, and the preview
 /// at `camera` within `budget`.
 fn preview_after_seed(s: &Scene, camera: &CameraSpec, budget: PreviewBudget) -> Shown {
-    let octree = s.build_octree().unwrap();
-    let seed = Renderer::new(s, &octree, s.render_settings()).unwrap();
-    let r = Renderer::with_camera(s, &octree, s.render_settings(), camera).unwrap();
+    let accel = crate::render::Accelerator::of_octree(s, s.build_octree().unwrap());
+    let seed = Renderer::new(s, &accel, s.render_settings()).unwrap();
+    let r = Renderer::with_camera(s, &accel, s.render_settings(), camera).unwrap();
     let shown = exact(s, &s.camera);
     let mut cache = RenderCache::default();
     show(&mut cache, &r, Some((&seed, &shown)), budget)
@@ -207,8 +207,8 @@ fn fresh_rays_give_the_one_sample_picture() {
     // (the same integrator, in packets where the scene allows).
     let s = scene(48, DVec3::ZERO);
     let camera = turned(&s, 10.0);
-    let octree = s.build_octree().unwrap();
-    let r = Renderer::with_camera(&s, &octree, s.render_settings(), &camera).unwrap();
+    let accel = crate::render::Accelerator::of_octree(&s, s.build_octree().unwrap());
+    let r = Renderer::with_camera(&s, &accel, s.render_settings(), &camera).unwrap();
     let mut cache = RenderCache::default();
     let preview = show(&mut cache, &r, None, all_the_time());
     assert_eq!(preview.summary.fresh, preview.summary.pixels());
@@ -252,8 +252,8 @@ fn a_surface_moving_in_front_hides_what_it_covers() {
     let camera = turned(&s, 6.0);
     let preview = preview_after_seed(&s, &camera, no_time());
     let truth = exact(&s, &camera);
-    let octree = s.build_octree().unwrap();
-    let r = Renderer::with_camera(&s, &octree, s.render_settings(), &camera).unwrap();
+    let accel = crate::render::Accelerator::of_octree(&s, s.build_octree().unwrap());
+    let r = Renderer::with_camera(&s, &accel, s.render_settings(), &camera).unwrap();
     let (w, h) = (preview.width, preview.height);
     let mut query_scratch = crate::render::renderer::Scratch::default();
     let mut query = crate::render::renderer::Query {
@@ -296,12 +296,12 @@ fn a_material_edit_retraces_the_pixels_that_met_it() {
     // background is untouched. With time, the preview is the new picture,
     // byte for byte, though not every pixel was traced again.
     let s = scene(96, DVec3::ZERO);
-    let octree = s.build_octree().unwrap();
-    let seed = Renderer::new(&s, &octree, s.render_settings()).unwrap();
+    let accel = crate::render::Accelerator::of_octree(&s, s.build_octree().unwrap());
+    let seed = Renderer::new(&s, &accel, s.render_settings()).unwrap();
     let shown = exact(&s, &s.camera);
     let mut edited = s.clone();
     edited.materials[1].color = DVec3::new(0.1, 0.8, 0.2);
-    let r = Renderer::new(&edited, &octree, edited.render_settings()).unwrap();
+    let r = Renderer::new(&edited, &accel, edited.render_settings()).unwrap();
     let mut cache = RenderCache::default();
     let stale = show(&mut cache, &r, Some((&seed, &shown)), no_time());
     assert!(stale.summary.stale > 0);
@@ -327,14 +327,14 @@ fn a_traced_point_knows_the_materials_it_met() {
     // sphere marks only pixels whose rays met it: most of the floor (its
     // shadow rays and the sky beyond) is kept.
     let s = scene(64, DVec3::ZERO);
-    let octree = s.build_octree().unwrap();
-    let r = Renderer::new(&s, &octree, s.render_settings()).unwrap();
+    let accel = crate::render::Accelerator::of_octree(&s, s.build_octree().unwrap());
+    let r = Renderer::new(&s, &accel, s.render_settings()).unwrap();
     let mut cache = RenderCache::default();
     let first = show(&mut cache, &r, None, all_the_time());
     assert_eq!(first.summary.fresh, first.summary.pixels());
     let mut edited = s.clone();
     edited.materials[1].color = DVec3::new(0.1, 0.8, 0.2);
-    let r = Renderer::new(&edited, &octree, edited.render_settings()).unwrap();
+    let r = Renderer::new(&edited, &accel, edited.render_settings()).unwrap();
     let second = show(&mut cache, &r, None, no_time());
     assert!(second.summary.stale > 0);
     assert!(
@@ -363,12 +363,12 @@ fn a_traced_point_knows_the_materials_it_met() {
 #[test]
 fn a_moved_light_marks_every_lit_surface() {
     let s = scene(64, DVec3::ZERO);
-    let octree = s.build_octree().unwrap();
-    let seed = Renderer::new(&s, &octree, s.render_settings()).unwrap();
+    let accel = crate::render::Accelerator::of_octree(&s, s.build_octree().unwrap());
+    let seed = Renderer::new(&s, &accel, s.render_settings()).unwrap();
     let shown = exact(&s, &s.camera);
     let mut moved = s.clone();
     moved.lights[0].position.x += 2.0;
-    let r = Renderer::new(&moved, &octree, moved.render_settings()).unwrap();
+    let r = Renderer::new(&moved, &accel, moved.render_settings()).unwrap();
     let mut cache = RenderCache::default();
     let stale = show(&mut cache, &r, Some((&seed, &shown)), no_time());
     // Every pixel is stale but the sky's.
@@ -389,8 +389,8 @@ fn a_moved_light_marks_every_lit_surface() {
 #[test]
 fn other_geometry_or_settings_start_over() {
     let s = scene(32, DVec3::ZERO);
-    let octree = s.build_octree().unwrap();
-    let r = Renderer::new(&s, &octree, s.render_settings()).unwrap();
+    let accel = crate::render::Accelerator::of_octree(&s, s.build_octree().unwrap());
+    let r = Renderer::new(&s, &accel, s.render_settings()).unwrap();
     let mut cache = RenderCache::default();
     cache.preview(&r, None, all_the_time());
     assert!(cache.can_serve(&r));
@@ -398,11 +398,11 @@ fn other_geometry_or_settings_start_over() {
         max_depth: 2,
         ..s.render_settings()
     };
-    let r2 = Renderer::new(&s, &octree, deeper).unwrap();
+    let r2 = Renderer::new(&s, &accel, deeper).unwrap();
     assert!(!cache.can_serve(&r2));
     let other = scene(32, DVec3::ZERO);
-    let octree2 = other.build_octree().unwrap();
-    let r3 = Renderer::new(&other, &octree2, other.render_settings()).unwrap();
+    let accel2 = crate::render::Accelerator::of_octree(&other, other.build_octree().unwrap());
+    let r3 = Renderer::new(&other, &accel2, other.render_settings()).unwrap();
     assert!(!cache.can_serve(&r3), "other geometry");
     // Samples and the accelerator change nothing a preview shows.
     let aa = RenderSettings {
@@ -410,7 +410,7 @@ fn other_geometry_or_settings_start_over() {
         adaptive: true,
         ..s.render_settings()
     };
-    assert!(cache.can_serve(&Renderer::new(&s, &octree, aa).unwrap()));
+    assert!(cache.can_serve(&Renderer::new(&s, &accel, aa).unwrap()));
 }
 
 #[test]
@@ -459,8 +459,8 @@ fn the_source_view_tells_the_sources_apart() {
     // One traced preview, then one with no time from a turned eye: fresh,
     // reused and filled pixels each get their own hue.
     let s = scene(64, DVec3::ZERO);
-    let octree = s.build_octree().unwrap();
-    let r = Renderer::new(&s, &octree, s.render_settings()).unwrap();
+    let accel = crate::render::Accelerator::of_octree(&s, s.build_octree().unwrap());
+    let r = Renderer::new(&s, &accel, s.render_settings()).unwrap();
     let mut cache = RenderCache::default();
     cache.preview(&r, None, all_the_time());
     let mut colors = Vec::new();
@@ -472,7 +472,7 @@ fn the_source_view_tells_the_sources_apart() {
         "fresh: green {fresh:?}"
     );
     let turned_eye =
-        Renderer::with_camera(&s, &octree, s.render_settings(), &turned(&s, 8.0)).unwrap();
+        Renderer::with_camera(&s, &accel, s.render_settings(), &turned(&s, 8.0)).unwrap();
     cache.preview(&turned_eye, None, no_time());
     cache.source_colors(&mut colors);
     let sources = cache.sources();

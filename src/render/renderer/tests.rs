@@ -1,4 +1,5 @@
-//! The renderer's routes, shadow hints and light buffer against brute force.
+//! What the renderer's queries walk, its shadow hints and light buffer
+//! against brute force.
 
 use super::*;
 use crate::accel::sphere_grid;
@@ -31,13 +32,29 @@ fn scene_of(shapes: Vec<crate::shapes::Shape>) -> Scene {
     scene
 }
 
-fn routes(renderer: &Renderer) -> (Route, Route, bool, bool) {
+/// Whether counted and uncounted queries (eye-ray packets among them)
+/// walk the octree.
+fn walks_octree(renderer: &Renderer) -> (bool, bool) {
     (
-        renderer.route::<WorkCounts>(),
-        renderer.route::<NoCounts>(),
-        renderer.packets_through_octree::<WorkCounts>(),
-        renderer.packets_through_octree::<NoCounts>(),
+        renderer.walked_octree::<WorkCounts>().is_some(),
+        renderer.walked_octree::<NoCounts>().is_some(),
     )
+}
+
+/// The accelerator `settings` ask for over `scene`, with a light buffer
+/// built where it would be asked, or given (`Some`).
+fn built(
+    scene: &Scene,
+    settings: RenderSettings,
+    octree: Option<&std::sync::Arc<Octree>>,
+    light_buffer: Option<crate::render::LightBufferSource>,
+) -> Accelerator {
+    let reuse = crate::render::Reuse {
+        octree: octree.cloned(),
+        bvh: None,
+        light_buffer: light_buffer.unwrap_or_default(),
+    };
+    Accelerator::build(scene, &settings, reuse).unwrap()
 }
 
 /// Shadow rays in runs that share an origin and nearly a direction,
@@ -54,8 +71,8 @@ fn shadow_hints_change_no_answer() {
     scene.materials.push(glass);
     let materials: Vec<u32> = (0..27).map(|i| (i % 5 == 0) as u32).collect();
     scene.shape_materials = std::sync::Arc::new(materials);
-    let octree = scene.build_octree().unwrap();
-    let renderer = Renderer::new(&scene, &octree, scene.render_settings()).unwrap();
+    let accel = crate::render::Accelerator::of_octree(&scene, scene.build_octree().unwrap());
+    let renderer = Renderer::new(&scene, &accel, scene.render_settings()).unwrap();
     assert!(renderer.shadow_hints);
     let mut uniform = uniform_from(0x2545_f491_4f6c_dd1d);
     let mut scratch = Scratch::default();
@@ -126,12 +143,11 @@ fn the_light_buffer_changes_no_answer() {
         color: DVec3::ONE,
     };
     scene.lights = vec![at(1.5, 1.5, 1.5), at(-2.0, 5.0, 0.5), at(3.0, 0.5, 0.5)];
-    let octree = scene.build_octree().unwrap();
-    let buffer = scene.build_light_buffer();
-    let plain = Renderer::new(&scene, &octree, scene.render_settings()).unwrap();
-    let buffered = Renderer::new(&scene, &octree, scene.render_settings())
-        .unwrap()
-        .with_light_buffer(buffer.as_ref());
+    let accel = crate::render::Accelerator::of_octree(&scene, scene.build_octree().unwrap());
+    let octree = accel.octree();
+    let with_buffer = built(&scene, scene.render_settings(), octree, None);
+    let plain = Renderer::new(&scene, &accel, scene.render_settings()).unwrap();
+    let buffered = Renderer::new(&scene, &with_buffer, scene.render_settings()).unwrap();
     assert!(buffered.has_light_buffer() && !plain.has_light_buffer());
     let mut uniform = uniform_from(0x853c_49e6_748f_ea9b);
     let (mut scratch, mut plain_scratch) = (Scratch::default(), Scratch::default());
@@ -165,47 +181,51 @@ fn the_light_buffer_changes_no_answer() {
     }
     assert!(blocked > 300 && lit > 300, "{blocked} blocked, {lit} lit");
     // Brute force stays brute force; a moved light finds no buffer.
+    let buffer = with_buffer.shared_light_buffer().cloned();
+    let given = || Some(crate::render::LightBufferSource::Given(buffer.clone()));
     let mut off = scene.render_settings();
     off.accel = Accel::BruteForce;
-    let brute = Renderer::new(&scene, &octree, off).unwrap();
-    assert!(!brute.with_light_buffer(buffer.as_ref()).has_light_buffer());
+    assert!(built(&scene, off, None, given()).light_buffer().is_none());
     let mut moved = scene.clone();
     moved.lights[2].position.x += 1e-9;
-    let renderer = Renderer::new(&moved, &octree, moved.render_settings()).unwrap();
+    let moved_accel = built(&moved, moved.render_settings(), octree, given());
+    assert!(moved_accel.light_buffer().is_none());
     assert!(
-        !renderer
-            .with_light_buffer(buffer.as_ref())
-            .has_light_buffer()
+        built(&scene, scene.render_settings(), octree, given())
+            .light_buffer()
+            .is_some()
     );
 }
 
 #[test]
 fn a_one_leaf_tree_sends_only_counted_queries_through_the_octree() {
-    use Route::*;
     let few = scene_of(sphere_grid(1, 0.5));
     let many = scene_of(sphere_grid(4, 0.3));
-    for (scene, uncounted) in [(&few, BruteForce), (&many, Octree)] {
-        let octree = scene.build_octree().unwrap();
-        assert_eq!(octree.is_one_leaf(), uncounted == BruteForce);
-        let bvh = crate::accel::Bvh::build(&scene.shapes);
+    for (scene, one_leaf) in [(&few, true), (&many, false)] {
         let mut settings = scene.render_settings();
-        let renderer = Renderer::new(scene, &octree, settings).unwrap();
-        let packets = uncounted == Octree;
-        assert_eq!(routes(&renderer), (Octree, uncounted, true, packets));
-        // A BVH takes every query, counted or not, and no packets;
-        // asked for but not given, the settings' octree switch decides.
-        settings.accel = Accel::Bvh;
-        let without = Renderer::new(scene, &octree, settings).unwrap();
-        assert_eq!(routes(&without), (BruteForce, BruteForce, false, false));
-        let with = Renderer::new(scene, &octree, settings)
-            .unwrap()
-            .with_bvh(&bvh);
-        assert_eq!(routes(&with), (Bvh, Bvh, false, false));
-        settings.accel = Accel::BruteForce;
-        let brute = Renderer::new(scene, &octree, settings)
-            .unwrap()
-            .with_bvh(&bvh);
-        assert_eq!(routes(&brute), (BruteForce, BruteForce, false, false));
+        let accel = built(scene, settings, None, None);
+        assert_eq!(accel.octree().unwrap().is_one_leaf(), one_leaf);
+        let renderer = Renderer::new(scene, &accel, settings).unwrap();
+        assert_eq!(walks_octree(&renderer), (true, !one_leaf));
+        // A BVH takes every query, counted or not, and no packets; brute
+        // force walks nothing.
+        for other in [Accel::Bvh, Accel::BruteForce] {
+            settings.accel = other;
+            let accel = built(scene, settings, None, None);
+            let renderer = Renderer::new(scene, &accel, settings).unwrap();
+            assert_eq!(walks_octree(&renderer), (false, false));
+            assert_eq!(renderer.accelerator().bvh().is_some(), other == Accel::Bvh);
+            // Settings that ask for another accelerator than the one
+            // given are refused, not quietly rendered through it.
+            let octree_settings = RenderSettings {
+                accel: Accel::Octree,
+                ..settings
+            };
+            assert!(matches!(
+                Renderer::new(scene, &accel, octree_settings),
+                Err(RenderError::AccelMismatch { .. })
+            ));
+        }
     }
 }
 
@@ -258,24 +278,21 @@ fn shadow_rays_skipping_their_plane_change_no_picture() {
             light(-3.0, 5.0, 2.0),
             light(0.5, 1.62, -4.0),
         ];
-        let octree = scene.build_octree().unwrap();
-        let buffer = scene.build_light_buffer();
+        let accel = crate::render::Accelerator::of_octree(&scene, scene.build_octree().unwrap());
         let mut settings = scene.render_settings();
         (settings.width, settings.height, settings.samples) = (96, 72, 1);
-        let skipping = Renderer::new(&scene, &octree, settings)
-            .unwrap()
-            .with_light_buffer(buffer.as_ref());
-        let walking = Renderer::new(&scene, &octree, settings).unwrap();
+        let with_buffer = built(&scene, settings, accel.octree(), None);
+        let skipping = Renderer::new(&scene, &with_buffer, settings).unwrap();
+        let walking = Renderer::new(&scene, &accel, settings).unwrap();
         assert!(skipping.skips_planes && walking.skips_planes);
-        let brute = Renderer::new(
-            &scene,
-            &octree,
-            RenderSettings {
-                accel: Accel::BruteForce,
-                ..settings
-            },
-        )
-        .unwrap();
+        assert!(skipping.has_light_buffer());
+        let brute_settings = RenderSettings {
+            accel: Accel::BruteForce,
+            ..settings
+        };
+        let brute_accel = built(&scene, brute_settings, None, None);
+        let brute = Renderer::new(&scene, &brute_accel, brute_settings).unwrap();
+        assert!(!brute.skips_planes);
         let picture = |r: &Renderer| r.render(false, None).0.to_rgb8();
         let expected = picture(&brute);
         assert!(

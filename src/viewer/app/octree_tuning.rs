@@ -136,8 +136,10 @@ impl GlintApp {
                 accel: Accel::Octree,
                 ..self.edit.settings
             };
-            if let Ok(renderer) =
-                Renderer::with_camera(&self.edit.scene, &self.octree, settings, &self.edit.camera)
+            let reuse = crate::render::Reuse::octree_alone(&self.octree);
+            if let Ok(accel) = crate::render::Accelerator::build(&self.edit.scene, &settings, reuse)
+                && let Ok(renderer) =
+                    Renderer::with_camera(&self.edit.scene, &accel, settings, &self.edit.camera)
             {
                 self.unit_costs = UnitCosts::measure(&renderer, &self.octree).ok();
             }

@@ -6,6 +6,7 @@ use super::Preview;
 use super::pass_cache::PassKey;
 use crate::accel::{Bvh, Octree};
 use crate::camera::CameraSpec;
+use crate::render::{Accelerator, LightBufferSource, Reuse};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 
@@ -36,6 +37,23 @@ pub struct Job {
 }
 
 impl Job {
+    /// The accelerator of this job's octree or BVH over `scene` (this
+    /// job's, or an earlier version of it with the same shapes) at
+    /// `settings`, with the light buffer `light_buffer` gives.
+    pub(super) fn accelerator(
+        &self,
+        scene: &Scene,
+        settings: &RenderSettings,
+        light_buffer: LightBufferSource,
+    ) -> Result<Accelerator, crate::accel::OctreeError> {
+        let reuse = Reuse {
+            octree: Some(Arc::clone(&self.octree)),
+            bvh: self.bvh.clone(),
+            light_buffer,
+        };
+        Accelerator::build(scene, settings, reuse)
+    }
+
     /// What decides pass `pass` of this job, for the pass cache.
     pub(super) fn pass_key(&self, pass: crate::render::PassKind) -> PassKey {
         PassKey::of(

@@ -1,9 +1,9 @@
 //! The light buffer the worker keeps between jobs.
 
 use std::sync::Arc;
-use std::time::Instant;
 
 use crate::accel::LightBuffer;
+use crate::render::{Accelerator, LightBufferSource};
 use crate::scene::Scene;
 
 /// The light buffer of the newest scene's shapes and lights, kept from
@@ -13,39 +13,51 @@ use crate::scene::Scene;
 pub(super) struct LightBufferCache {
     /// The geometry it was built over (a scene's clone shares it).
     pub(super) shapes: Option<Arc<Vec<crate::shapes::Shape>>>,
-    pub(super) buffer: Option<LightBuffer>,
+    pub(super) buffer: Option<Arc<LightBuffer>>,
     /// Its build's seconds.
     seconds: f64,
 }
 
 impl LightBufferCache {
-    /// The kept buffer, if it is of `scene`'s shapes and lights.
-    pub(super) fn kept(&self, scene: &Scene) -> Option<&LightBuffer> {
-        let lights: Vec<_> = scene.lights.iter().map(|l| l.position).collect();
+    /// The kept buffer, if it is of `scene`'s shapes (the accelerator
+    /// checks the lights).
+    fn of_shapes(&self, scene: &Scene) -> Option<Arc<LightBuffer>> {
         let same_shapes = self
             .shapes
             .as_ref()
             .is_some_and(|s| Arc::ptr_eq(s, &scene.shapes));
-        self.buffer
-            .as_ref()
-            .filter(|b| same_shapes && b.fits(scene.shapes.len(), &lights))
+        self.buffer.clone().filter(|_| same_shapes)
     }
 
-    /// The buffer of `scene`'s shapes and lights, built now if the kept
-    /// one is of others, and its build's seconds.
-    pub(super) fn get(&mut self, scene: &Scene) -> Option<(&LightBuffer, f64)> {
+    /// The kept buffer and nothing else: while a light is dragged, its
+    /// build would take a preview's time every frame.
+    pub(super) fn kept(&self, scene: &Scene) -> LightBufferSource {
+        LightBufferSource::Given(self.of_shapes(scene))
+    }
+
+    /// The kept buffer where it is of `scene`'s shapes and lights, built
+    /// again otherwise.
+    pub(super) fn current(&self, scene: &Scene) -> LightBufferSource {
         let lights: Vec<_> = scene.lights.iter().map(|l| l.position).collect();
-        let same_shapes = self
-            .shapes
-            .as_ref()
-            .is_some_and(|s| Arc::ptr_eq(s, &scene.shapes));
-        let fits = |b: &LightBuffer| b.fits(scene.shapes.len(), &lights);
-        if !same_shapes || !self.buffer.as_ref().is_some_and(fits) {
-            let start = Instant::now();
-            self.buffer = scene.build_light_buffer();
-            self.seconds = start.elapsed().as_secs_f64();
+        match self.of_shapes(scene) {
+            Some(b) if b.fits(scene.shapes.len(), &lights) => LightBufferSource::Given(Some(b)),
+            _ => LightBufferSource::Build,
+        }
+    }
+
+    /// Keeps the buffer `accel` was built with, if it built one, and
+    /// returns the seconds of the kept buffer's build.
+    pub(super) fn keep(&mut self, scene: &Scene, accel: &Accelerator) -> f64 {
+        if let Some(b) = accel.shared_light_buffer()
+            && !self
+                .buffer
+                .as_ref()
+                .is_some_and(|kept| Arc::ptr_eq(kept, b))
+        {
+            self.buffer = Some(Arc::clone(b));
+            self.seconds = accel.build_seconds().1;
             self.shapes = Some(Arc::clone(&scene.shapes));
         }
-        self.buffer.as_ref().map(|b| (b, self.seconds))
+        self.seconds
     }
 }

@@ -119,12 +119,24 @@ fn the_light_buffer_follows_moved_lights_and_new_geometry() {
         color: DVec3::ONE,
     }];
     let mut cache = LightBufferCache::default();
+    // Through the BVH: a one-leaf octree of one sphere asks no buffer.
     let fits = |c: &mut LightBufferCache, s: &crate::scene::Scene| {
+        let settings = crate::settings::RenderSettings {
+            accel: crate::settings::Accel::Bvh,
+            ..s.render_settings()
+        };
+        let reuse = crate::render::Reuse {
+            light_buffer: c.current(s),
+            ..crate::render::Reuse::default()
+        };
+        let accel = crate::render::Accelerator::build(s, &settings, reuse).unwrap();
+        c.keep(s, &accel);
         let lights: Vec<_> = s.lights.iter().map(|l| l.position).collect();
-        c.get(s)
-            .is_some_and(|(b, _)| b.fits(s.shapes.len(), &lights))
+        accel
+            .light_buffer()
+            .is_some_and(|b| b.fits(s.shapes.len(), &lights))
     };
-    let address = |c: &LightBufferCache| c.buffer.as_ref().map(|b| b as *const _);
+    let address = |c: &LightBufferCache| c.buffer.as_ref().map(Arc::as_ptr);
     assert!(fits(&mut cache, &scene));
     let first = address(&cache);
     // A new camera keeps it; a moved light builds it again.

@@ -2,9 +2,10 @@
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use glint::accel::Octree;
-use glint::render::Renderer;
+use glint::render::{Accelerator, Renderer, Reuse};
 use glint::scene::Scene;
 use glint::settings::RenderSettings;
 use glint::stats::RenderCounts;
@@ -44,10 +45,10 @@ pub fn load(rel: &str) -> Scene {
 /// A scene of `scenes/` loaded and its octree built once per test run:
 /// several tests go through every scene, and the largest take seconds to
 /// load and build. (Each caller gets the same shared copy.)
-pub fn loaded(rel: &str) -> std::sync::Arc<(Scene, Octree)> {
+pub fn loaded(rel: &str) -> std::sync::Arc<(Scene, Arc<Octree>)> {
     use std::collections::HashMap;
-    use std::sync::{Arc, Mutex, OnceLock};
-    type Cache = Mutex<HashMap<String, Arc<OnceLock<Arc<(Scene, Octree)>>>>>;
+    use std::sync::{Mutex, OnceLock};
+    type Cache = Mutex<HashMap<String, Arc<OnceLock<Arc<(Scene, Arc<Octree>)>>>>>;
     static CACHE: OnceLock<Cache> = OnceLock::new();
     // The map's lock is held only to find the scene's slot, so two scenes
     // load at once; one scene loads once.
@@ -63,7 +64,7 @@ pub fn loaded(rel: &str) -> std::sync::Arc<(Scene, Octree)> {
         let octree = scene
             .build_octree()
             .unwrap_or_else(|e| panic!("{rel}: {e}"));
-        Arc::new((scene, octree))
+        Arc::new((scene, Arc::new(octree)))
     })
     .clone()
 }
@@ -102,7 +103,7 @@ pub fn all_scenes() -> Vec<String> {
 /// image and the counts.
 pub fn render_with(
     scene: &Scene,
-    octree: &Octree,
+    octree: &Arc<Octree>,
     width: u32,
     height: u32,
     adjust: impl FnOnce(&mut RenderSettings),
@@ -113,12 +114,25 @@ pub fn render_with(
     adjust(&mut settings);
     // With the light buffer a release render has (it answers only where
     // an accelerator would, so octree-off renders stay brute force).
-    let light_buffer = scene.build_light_buffer();
-    let renderer = Renderer::new(scene, octree, settings)
-        .unwrap()
-        .with_light_buffer(light_buffer.as_ref());
+    let accel = accelerator(scene, &settings, Some(octree));
+    let renderer = Renderer::new(scene, &accel, settings).unwrap();
     let (frame, counts) = renderer.render(false, None);
     (frame.to_rgb8(), counts)
+}
+
+/// The accelerator `settings` ask for over `scene`, through `octree`
+/// (built over its shapes) when they ask for the octree and one is given,
+/// with the light buffer a release render has.
+pub fn accelerator(
+    scene: &Scene,
+    settings: &RenderSettings,
+    octree: Option<&Arc<Octree>>,
+) -> Accelerator {
+    let reuse = Reuse {
+        octree: octree.cloned(),
+        ..Reuse::default()
+    };
+    Accelerator::build(scene, settings, reuse).unwrap()
 }
 
 /// Number of pixels whose channels differ by more than `tolerance`, and the
