@@ -15,8 +15,8 @@ pub const MAX_IMAGE_SIDE: u32 = 1 << 15;
 pub const MAX_PIXELS: u64 = 1 << 28;
 pub const MAX_RAY_DEPTH: u32 = 64;
 
-/// Most render threads per core: more only add switching (5,000 threads
-/// made a 0.12 s render take 19.5 s).
+/// Most render threads per core: more only add switching, which grows
+/// without bound (docs/notes/experiments.md, "Figures behind constants").
 pub const MAX_THREADS_PER_CORE: usize = 8;
 
 /// Largest image side the viewer renders: it keeps several frames of this

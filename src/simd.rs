@@ -37,7 +37,7 @@ impl SimdLevel {
     }
 
     /// Rays in a packet at this level (1: no packets).
-    pub fn lanes(self) -> usize {
+    pub fn packet_width(self) -> usize {
         match self {
             SimdLevel::Scalar => 1,
             SimdLevel::Avx2 => 4,

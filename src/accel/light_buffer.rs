@@ -19,20 +19,19 @@ use self::projection::{face_rect, merge_rows, nearest_distance, triangle_rows};
 use crate::math::{Aabb, DVec3};
 use crate::shapes::{PreparedRay, Shape};
 
-/// Cells along a side of each of the cube's six faces: 128 took tree 7 %
-/// fewer instructions a ray than 64, mount 4 %, balls 3 %, teapot 2 %, and
-/// no scene more; 192 gained tree and balls another 2 % for 2.25 times the
-/// memory and cost mount its cube (docs/notes/experiments.md).
+/// Cells along a side of each of the cube's six faces: finer cells list
+/// fewer shapes a shadow ray need not meet, at four times the memory per
+/// doubling; 128 is where the gain stopped paying for the memory
+/// (docs/notes/experiments.md, "Figures behind constants").
 const SIDE: usize = 128;
 const FACE_CELLS: usize = SIDE * SIDE;
 const CUBE_CELLS: usize = 6 * FACE_CELLS;
 /// Longest list a cell keeps; a longer one goes to the accelerator,
 /// except for the shadow rays that start nearer the light than its first
 /// `MAX_LIST` shapes leave (see [`DirectionCube`]). A ray tests only the
-/// shapes nearer the light than its origin, so a long list costs little:
-/// 32 took rings 13 % fewer instructions a ray than 12, balls 10 %,
-/// bunny 8 %, teapot 4 %, and no scene more than 0.5 % more
-/// (docs/notes/experiments.md).
+/// shapes nearer the light than its origin, so a long list costs little
+/// and spares a walk (docs/notes/experiments.md, "Figures behind
+/// constants").
 const MAX_LIST: usize = 32;
 /// Padding of a box's projection, in face coordinates (`[-1, 1]`): far
 /// more than the rounding of a ray's direction or of the projection.

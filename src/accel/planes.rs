@@ -85,7 +85,8 @@ impl PlaneGroups {
     /// Groups `shapes`: each triangle joins the one before it if all its
     /// vertices lie within the slack of that one's group's plane. A group
     /// of one triangle is kept as none: skipping a shape's own face saves
-    /// less than asking costs (1.4 % more instructions on tetra.nff).
+    /// less than asking costs (docs/notes/experiments.md, "Shadow rays skip
+    /// the triangles of the plane they leave").
     pub fn build(shapes: &[Shape]) -> Self {
         let mut scale: f64 = 0.0;
         for shape in shapes {

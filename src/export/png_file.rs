@@ -67,9 +67,10 @@ fn start_png<W: std::io::Write>(
 ) -> Result<png::Writer<W>, ExportError> {
     let encode = encode_error(path);
     let mut encoder = png::Encoder::new(out, width, height);
-    // fdeflate: at the default level, writing a 256x192 render took more
-    // instructions (583 a pixel) than tracing it; this takes a tenth of
-    // that, for files 7% (default.toml) to 46% (bunny normals) larger.
+    // fdeflate: at the default level, writing a render took more
+    // instructions than tracing it; the fast level takes a tenth of that
+    // for somewhat larger files (docs/notes/experiments.md, "Figures
+    // behind constants").
     // An animation is written once from finished frames and kept or
     // shared as one file: it takes the balanced level.
     encoder.set_compression(if animation.is_some() {

@@ -16,10 +16,10 @@ use crate::math::Color;
 use crate::render::ray_tree::{RayKind, RayRecorder};
 
 /// Largest difference, in 8-bit display steps on any channel, between
-/// neighbouring centre samples that still counts as smooth. Measured on
-/// `scenes/default.toml` at 800x600 against the full grid: 2 steps refine
-/// 11.7% of the pixels for 74 dB, 4 9.6% for 71 dB, 8 7.5% for 66 dB, 16
-/// 6.3% for 62 dB; 8 keeps a wide margin over the 45 dB glint aims for.
+/// neighbouring centre samples that still counts as smooth: the largest
+/// step that keeps a wide margin over the 45 dB against the full grid
+/// that glint aims for (docs/notes/experiments.md, "Figures behind
+/// constants").
 pub const CONTRAST: u8 = 8;
 
 /// What an eye ray met, for telling edges apart: the material of its first

@@ -91,8 +91,7 @@ impl<C: Counter, const N: usize> pulp::WithSimd for ClosestWalk<'_, '_, C, N> {
 
 /// The secondary rays of a packet's hits, as a function of its own per
 /// SIMD level (see [`ClosestWalk`]): inlined into the eye rays' function,
-/// its size cost the scenes without secondary rays 3 % of their
-/// instructions.
+/// its size would slow the scenes without secondary rays.
 struct SecondaryWork<'w, 'r, 'a, 'q, C, R, const N: usize> {
     renderer: &'r Renderer<'a>,
     rays: &'w [Ray],
@@ -139,7 +138,7 @@ impl Renderer<'_> {
     /// view that does not count each ray's own work (the cost views trace
     /// ray by ray).
     pub(super) fn uses_packets(&self) -> bool {
-        self.simd.lanes() > 1 && !self.settings.view.is_cost()
+        self.simd.packet_width() > 1 && !self.settings.view.is_cost()
     }
 
     /// [`Renderer::run_tile`]'s work, in packets of `N` eye rays.
@@ -430,9 +429,8 @@ impl Renderer<'_> {
             }
         }
         // Loops, not `std::array::from_fn`: its closures, once too large to
-        // inline (as `toward_light` became), are compiled apart from this
-        // function's SIMD level, and calling them cost the default scene a
-        // third more time at 1 spp (2026-11-28).
+        // inline, are compiled apart from this function's SIMD level and
+        // run without its vector instructions.
         let mut origins = [DVec3::ZERO; N];
         let mut shapes = [0; N];
         for k in 0..n {

@@ -261,8 +261,7 @@ pub struct Renderer<'a> {
     accel: &'a Accelerator,
     /// Whether shadow rays test the shape that last blocked their light's
     /// first ([`ShadowHint`]): not on a scene of a few shapes, where the
-    /// query costs about what the hint does (1 % more instructions per
-    /// ray on the two- to six-shape scenes).
+    /// query costs about what the hint does.
     shadow_hints: bool,
     pub(super) settings: RenderSettings,
     pub(super) camera: Camera,

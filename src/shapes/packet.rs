@@ -150,10 +150,10 @@ impl<const N: usize> PacketHits<N> {
     /// a lower index (hits are rare: lane by lane).
     #[inline(always)]
     pub fn merge(&mut self, index: u32, hit: u32, t: F64s<N>, b1: F64s<N>, b2: F64s<N>) {
-        let mut lanes = hit;
-        while lanes != 0 {
-            let i = lanes.trailing_zeros() as usize;
-            lanes &= lanes - 1;
+        let mut left = hit;
+        while left != 0 {
+            let i = left.trailing_zeros() as usize;
+            left &= left - 1;
             if wins(t[i], index, self.t[i], self.shape[i]) {
                 self.t[i] = t[i];
                 self.b1[i] = b1[i];

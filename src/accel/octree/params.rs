@@ -27,9 +27,10 @@ pub struct OctreeParams {
 
 /// Chosen by `glint bench --sweep` (benches/octree_sweep_256.md).
 pub const DEFAULT_MAX_DUPLICATION: u32 = 8;
-/// Far above what any real scene needs (the 65,536-triangle tetra_s8 takes
-/// 15 MiB), far below this machine's memory, and small enough that the
-/// build finishes in seconds even when a scene would use it all.
+/// Far above what any real scene needs, far below a laptop's memory, and
+/// small enough that the build finishes in seconds even when a scene
+/// would use it all (docs/notes/experiments.md, "Figures behind
+/// constants").
 pub const DEFAULT_MEMORY_BUDGET_MIB: u32 = 128;
 
 fn default_max_duplication() -> u32 {
@@ -43,16 +44,13 @@ fn default_memory_budget_mib() -> u32 {
 impl Default for OctreeParams {
     fn default() -> Self {
         // Chosen by `glint bench --sweep` over the seven SPD scenes
-        // (benches/octree_sweep_256.md): leaf size 4 renders within 3% of
-        // the fastest configuration (run-to-run noise) with half its
-        // intersection tests, at most 0.33x Havran's best octree on every
-        // scene; depth 12 and leaf size 2 were slower. The cost-driven stop
-        // is on: without it the SPD generator's `shells` (1,441 nested,
-        // overlapping spheres) split until the memory budget and took 2.3 s
-        // at 200x150 against 0.62 s without an octree (0.07 s with the
-        // stop); on the SPD and bundled scenes its build and render stay
-        // within noise of the unstopped tree, and tetra_s8 builds in 1.2 s
-        // instead of 2.0 s (docs/benchmarks.md, "The default octree").
+        // (benches/octree_sweep_256.md): depth 10 and leaf size 4 render
+        // about as fast as the fastest setting with half its intersection
+        // tests. The cost-driven stop is on: without it nested, overlapping
+        // shapes (the SPD generator's `shells`) split until the memory
+        // budget and render slower than no octree at all, while elsewhere
+        // it changes nothing measurable (docs/benchmarks.md, "The default
+        // octree").
         Self {
             max_depth: 10,
             leaf_size: 4,
@@ -76,18 +74,12 @@ impl OctreeParams {
     /// mesh (at least 20,000 triangles, nine bounded shapes in ten), 4
     /// otherwise. A single ray tests a node's eight children at once
     /// against boxes of what they hold (`wide_walk.rs`), so on a large
-    /// mesh leaves of up to eight triangles render nearly as fast as the
-    /// four-reference leaves below them (3-4 % slower at 16 samples on
-    /// the bunnies and SPD gears), which cost two to three times the
-    /// build and twice the memory: the bunnies' tree builds in 0.08 s
-    /// instead of 0.14 s, gears' in 0.14 s instead of 0.38 s (vertex fans
-    /// kept as leaves either way, `build.rs`). On smaller meshes the
-    /// build is cheap and leaves of eight cost the packets' walk, which
-    /// tests every triangle of a leaf it enters: the bunny alone renders
-    /// 11 % slower at 16 samples, tetra 22 %. Cones, spheres and quadrics
-    /// cost several triangles' worth per test, so mixed scenes keep 4 (SPD
-    /// tree renders 32 % slower with 8). Figures: docs/benchmarks.md,
-    /// "Leaves of eight for large meshes".
+    /// mesh leaves of eight render nearly as fast as smaller ones and
+    /// halve the build's time and memory. On smaller meshes the build is
+    /// cheap and larger leaves cost the packets' walk, which tests every
+    /// triangle of a leaf it enters; cones, spheres and quadrics cost
+    /// several triangles' worth per test, so mixed scenes keep 4. Figures:
+    /// docs/benchmarks.md, "Leaves of eight for large meshes".
     pub fn default_for(shapes: &[Shape]) -> Self {
         // Only bounded shapes go into the tree (planes are tested apart).
         let bounded = shapes.iter().filter(|s| s.bounds().is_some()).count();

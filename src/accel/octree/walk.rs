@@ -335,10 +335,8 @@ impl<C: Counter> LeafVisitor for ClosestVisitor<'_, C> {
     #[inline(always)]
     fn visit_leaf<L: TriangleLanes>(&mut self, refs: &[u32], t_exit: f64, lanes: L) -> bool {
         // Uncounted, where the lanes can (triangles are most shapes):
-        // triangles four at a time, the rest one by one.
-        // One loop for each way (where the shadow visitor below has one
-        // loop and a flag): of the forms measured, these two compiled
-        // best (gears' instructions, docs/notes/experiments.md).
+        // triangles four at a time, the rest one by one, in a loop for
+        // each way (docs/notes/experiments.md compares the forms).
         if C::COUNTS || !L::FOUR_AT_ONCE {
             for &i in refs {
                 if !self.mailbox.seen(i) {

@@ -51,7 +51,7 @@ fn write_simd(out: &mut impl Write, json: bool) -> std::io::Result<()> {
     if json {
         let value = serde_json::json!({
             "level": choice.level,
-            "lanes": choice.level.lanes(),
+            "lanes": choice.level.packet_width(),
             "reason": choice.reason,
             "available": available,
         });
@@ -61,8 +61,12 @@ fn write_simd(out: &mut impl Write, json: bool) -> std::io::Result<()> {
         out,
         "simd       {} ({} lane{}): {}",
         choice.level.name(),
-        choice.level.lanes(),
-        if choice.level.lanes() == 1 { "" } else { "s" },
+        choice.level.packet_width(),
+        if choice.level.packet_width() == 1 {
+            ""
+        } else {
+            "s"
+        },
         choice.reason
     )?;
     writeln!(out, "available  {}", available.join(", "))?;
