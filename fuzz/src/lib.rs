@@ -9,7 +9,8 @@ use std::path::Path;
 use std::sync::OnceLock;
 
 use glint::accel::{Octree, OctreeError};
-use glint::render::Renderer;
+use glint::render::{Accelerator, Renderer, Reuse};
+use glint::settings::{Accel, RenderSettings};
 use glint::scene::{FileSource, Scene};
 
 /// Files by extension: the scene (`.toml`, `.nff`), the model (`.obj`) and
@@ -97,22 +98,24 @@ pub fn check_scene(scene: &mut Scene) {
     settings.max_depth = settings.max_depth.min(4);
     // The octree's render asks the light buffer too: its answers must be
     // brute force's.
-    let light_buffer = scene.build_light_buffer();
-    let render = |use_octree: bool| {
-        let mut s = settings;
-        s.use_octree = use_octree;
-        let renderer = Renderer::new(scene, &octree, s)
-            .ok()?
-            .with_light_buffer(light_buffer.as_ref());
+    let octree = std::sync::Arc::new(octree);
+    let render = |accel: Accel| {
+        let s = RenderSettings { accel, ..settings };
+        let reuse = Reuse {
+            octree: Some(std::sync::Arc::clone(&octree)),
+            ..Reuse::default()
+        };
+        let built = single_thread(|| Accelerator::build(scene, &s, reuse)).ok()?;
+        let renderer = Renderer::new(scene, &built, s).ok()?;
         Some(single_thread(|| renderer.render(false, None)).0)
     };
-    let Some(on) = render(true) else {
+    let Some(on) = render(Accel::Octree) else {
         return;
     };
     for p in &on.pixels {
         assert!(p.is_finite(), "a pixel is {p}");
     }
-    let off = render(false).expect("the same settings render");
+    let off = render(Accel::BruteForce).expect("the same settings render");
     assert_eq!(
         on.to_rgb8(),
         off.to_rgb8(),
