@@ -85,7 +85,7 @@ for scene in dict.fromkeys(r["scene"] for r in rows):
     mine = [r for r in rows if r["scene"] == scene]
     f = next(r for r in mine if r["fastest"])
     s = next(r for r in mine if r["suggested_from_rays"])
-    t = next(r for r in mine if r["suggested"])
+    t = next(r for r in mine if r["suggested_from_tree"])
     print(
         f"| {name(f)} | {total(f):.3f} | {describe(s)} | {total(s):.3f} | {total(s) / total(f):.2f} "
         f"| {describe(t)} | {total(t):.3f} | {total(t) / total(f):.2f} |"

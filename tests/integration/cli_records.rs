@@ -185,3 +185,58 @@ fn a_scene_too_large_to_embed_is_recorded_by_path_and_hash() {
         "{err}"
     );
 }
+
+/// A sweep marks as `suggested` the setting whose build plus render
+/// predicted from a sample of its rays is least (glint's suggestion, also
+/// `suggested_from_rays`), the tree-alone model's pick as
+/// `suggested_from_tree`, and the measured best as `fastest`: one row each.
+#[test]
+fn a_sweep_suggests_what_its_ray_sample_predicts_is_fastest() {
+    let scene = common::repo_path("scenes/spd/tetra.nff");
+    let out = glint(&[
+        "bench",
+        scene.to_str().unwrap(),
+        "--size",
+        "24x24",
+        "--samples",
+        "1",
+        "--octree-only",
+        "--repeat",
+        "1",
+        "--sweep",
+        "--sweep-depths",
+        "2,6",
+        "--sweep-leaf-sizes",
+        "2,8",
+        "--format",
+        "json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rows: Vec<serde_json::Value> = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        rows.len(),
+        8,
+        "two depths, two leaf sizes, cost-driven on and off"
+    );
+    let marked = |key: &str| {
+        let at: Vec<usize> = (0..rows.len()).filter(|&i| rows[i][key] == true).collect();
+        assert_eq!(at.len(), 1, "{key}: {at:?}");
+        at[0]
+    };
+    let cost = |i: usize, prediction: &str| {
+        rows[i]["build_s"].as_f64().unwrap() + rows[i][prediction]["render_s"].as_f64().unwrap()
+    };
+    let least = |prediction: &str| {
+        (0..rows.len())
+            .min_by(|&a, &b| cost(a, prediction).total_cmp(&cost(b, prediction)))
+            .unwrap()
+    };
+    assert_eq!(marked("suggested"), least("predicted_from_rays"));
+    assert_eq!(marked("suggested_from_rays"), marked("suggested"));
+    assert_eq!(marked("suggested_from_tree"), least("predicted"));
+    marked("fastest");
+}

@@ -313,12 +313,16 @@ struct SweepRow {
     /// The render as predicted from a sample of its own rays (a 64-pixel
     /// thumbnail traced through the tree), before it ran.
     predicted_from_rays: Prediction,
-    /// This scene's setting with the least predicted build plus render
-    /// time (the build measured, the render predicted from the tree).
+    /// glint's suggestion for this scene (the viewer's "Suggest a
+    /// setting"): the least build (measured) plus render predicted from
+    /// the sample of rays, the prediction that ranks renders as they run.
     suggested: bool,
-    /// The same with the render predicted from the sample of rays: the
-    /// suggestion glint makes (the viewer's "Suggest a setting").
+    /// The same as `suggested`, under its older name.
     suggested_from_rays: bool,
+    /// The least build plus render predicted from the tree alone (what
+    /// `suggested` marked before 2026-11-29): the surface-area model, blind
+    /// to the view.
+    suggested_from_tree: bool,
     /// This scene's setting with the least measured build plus render time.
     fastest: bool,
 }
@@ -443,6 +447,7 @@ fn sweep(args: &BenchArgs) -> Result<()> {
                 predicted_from_rays: ray_sample.predict(counts.rays.total(), threads),
                 suggested: false,
                 suggested_from_rays: false,
+                suggested_from_tree: false,
                 fastest: false,
             };
             if args.format == Format::Markdown {
@@ -461,16 +466,18 @@ fn sweep(args: &BenchArgs) -> Result<()> {
     Ok(())
 }
 
-/// Marks the row with the least predicted build + render and the one with
-/// the least measured build + render (the first of equals).
+/// Marks the rows with the least predicted build + render (from the rays:
+/// the suggestion; from the tree alone) and the one with the least
+/// measured build + render (the first of equals).
 fn mark_suggested_and_fastest(rows: &mut [SweepRow]) {
     let least = |rows: &[SweepRow], cost: fn(&SweepRow) -> f64| {
         (0..rows.len()).min_by(|&a, &b| cost(&rows[a]).total_cmp(&cost(&rows[b])))
     };
     if let Some(i) = least(rows, |r| r.build_s + r.predicted.render_s) {
-        rows[i].suggested = true;
+        rows[i].suggested_from_tree = true;
     }
     if let Some(i) = least(rows, |r| r.build_s + r.predicted_from_rays.render_s) {
+        rows[i].suggested = true;
         rows[i].suggested_from_rays = true;
     }
     if let Some(i) = least(rows, |r| r.build_s + r.render_s) {
@@ -508,9 +515,12 @@ fn print_suggestion(rows: &[SweepRow]) -> anyhow::Result<()> {
     for (label, chosen) in [
         (
             "from a sample of the render's rays",
-            rows.iter().find(|r| r.suggested_from_rays),
+            rows.iter().find(|r| r.suggested),
         ),
-        ("from the tree alone", rows.iter().find(|r| r.suggested)),
+        (
+            "from the tree alone",
+            rows.iter().find(|r| r.suggested_from_tree),
+        ),
     ] {
         if let Some(s) = chosen {
             out!(
