@@ -111,31 +111,26 @@ mod tests {
             .chain(&inner)
             .map(|p| DVec3::new(p[0], p[1], 0.0))
             .collect();
-        // 0 1 2 3, bridge 3 -> 7? Use a (0) and b (4): 0 4 5 6 7 4 0 1 2 3.
-        let ids = [0u32, 4, 5, 6, 7, 4, 0, 1, 2, 3];
-        let corners: Vec<DVec3> = ids.iter().map(|&k| points[k as usize]).collect();
-        let triangles = triangulate_keyhole(&ids, &corners).expect("a keyhole");
-        let covered: f64 = triangles
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|k| corners[k as usize]);
-                0.5 * (b - a).cross(c - a).z.abs()
-            })
-            .sum();
-        assert!((covered - 12.0).abs() < 1e-12, "covered {covered}");
+        // The area the triangles of the keyhole face `ids` cover.
+        let covered = |ids: &[u32]| -> f64 {
+            let corners: Vec<DVec3> = ids.iter().map(|&k| points[k as usize]).collect();
+            let triangles = triangulate_keyhole(ids, &corners).expect("a keyhole");
+            triangles
+                .iter()
+                .map(|t| {
+                    let [a, b, c] = t.map(|k| corners[k as usize]);
+                    0.5 * (b - a).cross(c - a).z.abs()
+                })
+                .sum()
+        };
+        // The bridge from corner 0 to corner 4 first, round the hole, back
+        // and round the outer loop.
+        let area = covered(&[0, 4, 5, 6, 7, 4, 0, 1, 2, 3]);
+        assert!((area - 12.0).abs() < 1e-12, "covered {area}");
         // The same ring written from the outer loop first, its bridge out
-        // being the closing edge: 0 1 2 3 0 4 5 6 7 4.
-        let ids = [0u32, 1, 2, 3, 0, 4, 5, 6, 7, 4];
-        let corners: Vec<DVec3> = ids.iter().map(|&k| points[k as usize]).collect();
-        let triangles = triangulate_keyhole(&ids, &corners).expect("a keyhole round the end");
-        let covered: f64 = triangles
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|k| corners[k as usize]);
-                0.5 * (b - a).cross(c - a).z.abs()
-            })
-            .sum();
-        assert!((covered - 12.0).abs() < 1e-12, "covered {covered}");
+        // being the closing edge.
+        let area = covered(&[0, 1, 2, 3, 0, 4, 5, 6, 7, 4]);
+        assert!((area - 12.0).abs() < 1e-12, "covered {area}");
         // A face without a bridge is not a keyhole.
         assert!(triangulate_keyhole(&[0, 1, 2, 3], &points[..4]).is_none());
     }

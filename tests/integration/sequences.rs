@@ -389,16 +389,20 @@ fn an_animation_named_as_a_frame_and_a_missing_keyframes_file_are_refused() {
     let tmp = common::temp_dir();
     let scene = common::repo_path("scenes/sphere.toml");
     let frame0 = tmp.path().join("t_0.png");
-    let o = glint(&[
-        "render",
-        scene.to_str().unwrap(),
-        "--turntable",
-        "2",
-        "-o",
-        tmp.path().join("t_#.png").to_str().unwrap(),
-        "--animation",
-        frame0.to_str().unwrap(),
-    ]);
+    // A two-frame turntable written to `frames`, animated into `animation`.
+    let turntable = |frames: &Path, animation: &Path| {
+        glint(&[
+            "render",
+            scene.to_str().unwrap(),
+            "--turntable",
+            "2",
+            "-o",
+            frames.to_str().unwrap(),
+            "--animation",
+            animation.to_str().unwrap(),
+        ])
+    };
+    let o = turntable(&tmp.path().join("t_#.png"), &frame0);
     let e = String::from_utf8_lossy(&o.stderr).into_owned();
     assert!(
         !o.status.success() && e.contains("also the name of frame 0"),
@@ -407,16 +411,7 @@ fn an_animation_named_as_a_frame_and_a_missing_keyframes_file_are_refused() {
     assert!(!frame0.exists(), "refused before any frame");
     // The same file by another spelling, in a folder not there yet.
     let fresh = tmp.path().join("new");
-    let o = glint(&[
-        "render",
-        scene.to_str().unwrap(),
-        "--turntable",
-        "2",
-        "-o",
-        fresh.join("t_#.png").to_str().unwrap(),
-        "--animation",
-        fresh.join("../new/t_1.png").to_str().unwrap(),
-    ]);
+    let o = turntable(&fresh.join("t_#.png"), &fresh.join("../new/t_1.png"));
     let e = String::from_utf8_lossy(&o.stderr).into_owned();
     assert!(
         !o.status.success() && e.contains("also the name of frame 1"),

@@ -320,8 +320,8 @@ struct SweepRow {
     /// The same as `suggested`, under its older name.
     suggested_from_rays: bool,
     /// The least build plus render predicted from the tree alone (what
-    /// `suggested` marked before 2026-11-29): the surface-area model, blind
-    /// to the view.
+    /// `suggested` once marked; docs/cli.md): the surface-area model,
+    /// blind to the view.
     suggested_from_tree: bool,
     /// This scene's setting with the least measured build plus render time.
     fastest: bool,
