@@ -34,5 +34,6 @@ pub mod settings;
 pub mod shapes;
 pub mod simd;
 pub mod stats;
+pub mod texture;
 #[cfg(feature = "gui")]
 pub mod viewer;

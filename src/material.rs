@@ -4,6 +4,7 @@ use crate::limits::{
     INTENSITY_RANGE, IOR_RANGE, SHININESS_RANGE, UNIT_RANGE, check_color, check_range,
 };
 use crate::math::{Color, DVec3};
+use crate::texture::TextureMap;
 
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Material {
@@ -25,6 +26,15 @@ pub struct Material {
     pub transparency: f64,
     /// Index of refraction of the inside of the surface (outside is 1).
     pub ior: f64,
+    /// The texture whose colour multiplies `color` (MTL's `map_Kd`, a TOML
+    /// material's `texture`) on shapes with texture coordinates.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub color_map: Option<TextureMap>,
+    /// The texture that cuts the surface away where its alpha (MTL's
+    /// `map_d`: its value) is below one half: eye and shadow rays pass
+    /// there, as through the gaps of a leaf or a fence.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cutout_map: Option<TextureMap>,
 }
 
 impl Material {
@@ -70,6 +80,8 @@ impl Default for Material {
             reflectivity: 0.0,
             transparency: 0.0,
             ior: 1.5,
+            color_map: None,
+            cutout_map: None,
         }
     }
 }

@@ -189,6 +189,9 @@ pub struct RenderSettings {
     /// Cast shadow rays (off only in the viewer's previews while moving:
     /// every light then reaches every point that faces it).
     pub shadows: bool,
+    /// Draw materials' textures (off: each textured material in its own
+    /// colour, with no cut-outs, to compare).
+    pub textures: bool,
 }
 
 /// [`RenderSettings`] as PNG records and JSON write them: the accelerator
@@ -215,6 +218,8 @@ struct RecordedSettings {
     shadows: bool,
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     bvh: bool,
+    #[serde(default = "yes", skip_serializing_if = "Clone::clone")]
+    textures: bool,
 }
 
 fn yes() -> bool {
@@ -240,6 +245,7 @@ impl From<RecordedSettings> for RenderSettings {
             sides: r.sides,
             adaptive: r.adaptive,
             shadows: r.shadows,
+            textures: r.textures,
         }
     }
 }
@@ -259,6 +265,7 @@ impl From<RenderSettings> for RecordedSettings {
             adaptive: s.adaptive,
             shadows: s.shadows,
             bvh: s.accel == Accel::Bvh,
+            textures: s.textures,
         }
     }
 }
@@ -421,6 +428,8 @@ pub struct Overrides {
     pub protocol: Option<Protocol>,
     pub colors: Option<ColorConvention>,
     pub sides: Option<Sides>,
+    /// Draw materials' textures (`--textures on|off`).
+    pub textures: Option<bool>,
 }
 
 /// Octree parameters overriding a scene's; `None` keeps the scene's.
@@ -487,6 +496,9 @@ impl Overrides {
         if let Some(s) = self.sides {
             settings.sides = s;
         }
+        if let Some(t) = self.textures {
+            settings.textures = t;
+        }
     }
 }
 
@@ -507,6 +519,7 @@ mod tests {
             sides: Sides::Two,
             adaptive: false,
             shadows: true,
+            textures: true,
         }
     }
 

@@ -148,6 +148,8 @@ fn materials() -> Vec<Material> {
         reflectivity: 0.0,
         transparency: 0.0,
         ior: 1.0,
+        color_map: None,
+        cutout_map: None,
     };
     vec![
         base.clone(),

@@ -171,6 +171,7 @@ class Scene:
         cancel=None,
         camera=None,
         frame=None,
+        textures=None,
     ):
         """Renders a :class:`Frame`. Unset arguments keep the scene's
         settings, as ``glint render``'s flags do: ``samples`` 1 or 16 or
@@ -186,7 +187,9 @@ class Scene:
         :class:`Cancelled`; Ctrl+C stops it with ``KeyboardInterrupt``.
         ``camera`` (a :class:`Viewpoint` or mapping) renders from there
         instead of the scene's camera; ``frame``, ``(index, count, time)``,
-        records the image as that frame of a sequence in its PNG."""
+        records the image as that frame of a sequence in its PNG.
+        ``textures=False`` draws each textured material in its own colour,
+        without cut-outs (``--textures off``)."""
         native = self._native.render(
             width,
             height,
@@ -204,6 +207,7 @@ class Scene:
             cancel=cancel,
             camera=None if camera is None else _as_viewpoint(camera)._native(),
             frame=frame,
+            textures=textures,
         )
         return Frame(native)
 
@@ -211,7 +215,8 @@ class Scene:
         """The tree of rays pixel (x, y)'s centre ray spawns, each with its
         octree walk, as nested dicts: ``glint render --trace-pixel X,Y``'s
         JSON. Takes ``width``, ``height``, ``octree``, ``accel``, ``max_depth``,
-        ``protocol``, ``colors``, ``sides`` as :meth:`render` does."""
+        ``protocol``, ``colors``, ``sides``, ``textures`` as :meth:`render`
+        does."""
         return _json.loads(self._native.trace_pixel(x, y, **settings))
 
     def octree(self, **params):

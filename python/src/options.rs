@@ -24,6 +24,8 @@ pub struct RenderOptions<'a> {
     pub protocol: Option<&'a str>,
     pub colors: Option<&'a str>,
     pub sides: Option<&'a str>,
+    /// Draw materials' textures (`--textures on|off`).
+    pub textures: Option<bool>,
 }
 
 /// A whole-number argument (`width`, `samples`, ...) as Python gave it,
@@ -111,6 +113,7 @@ impl RenderOptions<'_> {
             protocol,
             colors: parsed(self.colors)?,
             sides: parsed(self.sides)?,
+            textures: self.textures,
             ..Overrides::default()
         };
         let mut settings = scene.render_settings();

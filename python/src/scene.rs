@@ -306,7 +306,7 @@ impl PyScene {
 
     #[pyo3(signature = (width=None, height=None, samples=None, aa=None, octree=None,
         accel=None, max_depth=None, view=None, threads=None, stats=false, protocol=None, colors=None,
-        sides=None, cancel=None, camera=None, frame=None))]
+        sides=None, cancel=None, camera=None, frame=None, textures=None))]
     #[allow(clippy::too_many_arguments)]
     fn render(
         slf: &Bound<'_, Self>,
@@ -326,6 +326,7 @@ impl PyScene {
         cancel: Option<&Bound<'_, PyAny>>,
         camera: Option<CameraTuple>,
         frame: Option<FrameTuple>,
+        textures: Option<bool>,
     ) -> PyResult<PyFrame> {
         let py = slf.py();
         let mut snap = snapshot(slf);
@@ -345,14 +346,18 @@ impl PyScene {
             protocol,
             colors,
             sides,
+            textures,
         };
         let settings = options.settings(&snap.scene)?;
         let pool = thread_pool(threads)?;
         let (accel, build_s) = accelerator(slf, &snap, &settings, &pool, stats)?;
         let renderer =
             Renderer::new(&snap.scene, &accel, settings).map_err(|e| render_error(&e))?;
-        glint::render::memory::check_memory(&settings, accel.memory_bytes())
-            .map_err(|e| render_error(&e))?;
+        glint::render::memory::check_memory(
+            &settings,
+            accel.memory_bytes() + snap.scene.texture_bytes(),
+        )
+        .map_err(|e| render_error(&e))?;
         let stop = AtomicBool::new(false);
         let pass_options = PassOptions {
             count_work: stats,
@@ -402,7 +407,7 @@ impl PyScene {
     /// writes.
     #[pyo3(signature = (header, pixels, width=None, height=None, samples=None, aa=None,
         octree=None, accel=None, max_depth=None, view=None, protocol=None, colors=None,
-        sides=None, camera=None, frame=None))]
+        sides=None, camera=None, frame=None, textures=None))]
     #[allow(clippy::too_many_arguments)]
     fn frame_from_parts(
         slf: &Bound<'_, Self>,
@@ -421,6 +426,7 @@ impl PyScene {
         sides: Option<&str>,
         camera: Option<CameraTuple>,
         frame: Option<FrameTuple>,
+        textures: Option<bool>,
     ) -> PyResult<PyFrame> {
         let mut snap = snapshot(slf);
         if let Some(c) = camera {
@@ -438,6 +444,7 @@ impl PyScene {
             protocol,
             colors,
             sides,
+            textures,
         };
         let settings = options.settings(&snap.scene)?;
         let header: FrameHeader = serde_json::from_str(header)
@@ -511,7 +518,7 @@ impl PyScene {
     /// The `--trace-pixel` JSON of pixel (x, y) of the image these
     /// settings make.
     #[pyo3(signature = (x, y, width=None, height=None, octree=None, accel=None, max_depth=None,
-        protocol=None, colors=None, sides=None))]
+        protocol=None, colors=None, sides=None, textures=None))]
     #[allow(clippy::too_many_arguments)]
     fn trace_pixel(
         slf: &Bound<'_, Self>,
@@ -525,6 +532,7 @@ impl PyScene {
         protocol: Option<&str>,
         colors: Option<&str>,
         sides: Option<&str>,
+        textures: Option<bool>,
     ) -> PyResult<String> {
         let snap = snapshot(slf);
         let options = RenderOptions {
@@ -536,6 +544,7 @@ impl PyScene {
             protocol,
             colors,
             sides,
+            textures,
             ..RenderOptions::default()
         };
         let settings = glint::report::trace_settings(options.settings(&snap.scene)?);

@@ -49,6 +49,16 @@ pub enum ExportError {
         sha256: String,
         found: bool,
     },
+    #[error(
+        "{texture} {} since {png} was made, so its colours would not be the recorded ones: \
+         restore that texture to re-render the picture, or render the scene afresh",
+        if *found { "has changed (its SHA-256 differs from the recorded one)" } else { "cannot be read" }
+    )]
+    TextureChanged {
+        texture: String,
+        png: PathBuf,
+        found: bool,
+    },
     #[error("the recorded light and material edits do not fit the recorded scene {scene}")]
     EditsMismatch { scene: String },
     #[error(

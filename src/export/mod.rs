@@ -149,14 +149,23 @@ pub fn restore(png: &Path) -> Result<Restored, ExportError> {
             env!("CARGO_PKG_VERSION")
         ));
     }
-    // Meshes and material libraries are not embedded: say which changed
-    // since the export (the picture may then differ).
+    // Meshes, material libraries and textures are not embedded: a changed
+    // texture recolours the picture, so it is refused; for the others, say
+    // which changed since the export (the picture may then differ).
     for file in &record.settings.files {
         let now = scene
             .files_read
             .iter()
             .find(|f| absolute_name(&f.path) == file.path);
-        if now.is_none_or(|f| f.sha256 != file.sha256) {
+        let changed = now.is_none_or(|f| f.sha256 != file.sha256);
+        if changed && is_texture(&scene, &file.path) {
+            return Err(ExportError::TextureChanged {
+                texture: file.path.clone(),
+                png: png.to_owned(),
+                found: now.is_some(),
+            });
+        }
+        if changed {
             notes.push(format!(
                 "{} has changed since {} was made (its SHA-256 differs from the recorded one): \
                  pixels may differ",
@@ -181,6 +190,22 @@ pub fn restore(png: &Path) -> Result<Restored, ExportError> {
         frame: record.settings.frame,
         notes,
     })
+}
+
+/// Whether the recorded file `path` is one of `scene`'s textures, or an
+/// image that can be nothing else (a texture no longer found).
+fn is_texture(scene: &Scene, path: &str) -> bool {
+    let image = std::path::Path::new(path)
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| {
+            ["png", "jpg", "jpeg", "tga", "bmp"].contains(&e.to_ascii_lowercase().as_str())
+        });
+    image
+        || scene
+            .textures
+            .iter()
+            .any(|t| absolute_name(&t.path) == path)
 }
 
 /// The scene a record was made from: parsed from its embedded text, with

@@ -133,6 +133,7 @@ impl Renderer<'_> {
             }
             _ => self.materials[material as usize].color,
         };
+        let color = self.textured_color(color, material, hit.shape, &hit.hit);
         rec.material(material);
         rec.surface(point);
         rec.hit(|| HitRecord {

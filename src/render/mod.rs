@@ -17,6 +17,8 @@ mod passes;
 pub mod ray_tree;
 pub mod render_cache;
 mod sampling;
+mod texture_lookups;
+mod texturing;
 mod tile_job;
 pub mod tiles;
 mod unit_costs;

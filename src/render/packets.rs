@@ -134,11 +134,12 @@ impl<const N: usize> Default for PacketScratch<N> {
 }
 
 impl Renderer<'_> {
-    /// Whether this render traces packets: a SIMD level with lanes, and a
+    /// Whether this render traces packets: a SIMD level with lanes, a
     /// view that does not count each ray's own work (the cost views trace
-    /// ray by ray).
+    /// ray by ray), and no cut-out textures (a ray through a gap goes on
+    /// alone).
     pub(super) fn uses_packets(&self) -> bool {
-        self.simd.packet_width() > 1 && !self.settings.view.is_cost()
+        self.simd.packet_width() > 1 && !self.settings.view.is_cost() && !self.cuts_out
     }
 
     /// [`Renderer::run_tile`]'s work, in packets of `N` eye rays.

@@ -11,9 +11,10 @@ use crate::accel::{
 use crate::camera::{Camera, CameraError, CameraSpec, sample_offsets};
 use crate::limits::LimitError;
 use crate::material::Material;
-use crate::math::{Color, DVec3};
+use crate::math::{Color, DVec3, Ray};
 use crate::render::accelerator::{Accelerator, Structure};
 use crate::render::ray_tree::{RayKind, RayNode};
+use crate::render::texturing::Texturing;
 use crate::scene::Scene;
 use crate::settings::{Accel, RenderSettings, Sides, ViewMode};
 use crate::shapes::PreparedRay;
@@ -271,6 +272,11 @@ pub struct Renderer<'a> {
     /// compares one sample with 16 whatever `settings.samples` says).
     pub(super) grid: Vec<(f64, f64)>,
     is_transparent: Vec<bool>,
+    /// How textures are drawn, when the scene has them and they are on.
+    pub(super) texturing: Option<Texturing>,
+    /// Whether some triangle's material cuts it out: queries then look
+    /// past the gaps.
+    pub(super) cuts_out: bool,
     /// Per shape: seen from outside only ([`Sides::One`]); empty otherwise.
     one_sided: Vec<bool>,
     /// Single rays test triangles four at a time
@@ -320,10 +326,19 @@ impl<'a> Renderer<'a> {
         }
         let camera_spec = *camera;
         let camera = Camera::new(camera, settings.width, settings.height)?;
+        let texturing = Texturing::new(scene, &settings);
+        // Cut-out triangles let light through their gaps: shadow rays
+        // record their crossings as they do a transparent surface's.
         let is_transparent: Vec<bool> = scene
             .shape_materials
             .iter()
-            .map(|&m| scene.materials[m as usize].transparency > 0.0)
+            .enumerate()
+            .map(|(shape, &m)| {
+                scene.materials[m as usize].transparency > 0.0
+                    || texturing
+                        .as_ref()
+                        .is_some_and(|t| t.any_cut && t.cuts_shape(scene, shape))
+            })
             .collect();
         let one_sided = match settings.sides {
             Sides::Two => Vec::new(),
@@ -359,6 +374,8 @@ impl<'a> Renderer<'a> {
                 settings.samples
             }),
             is_transparent,
+            cuts_out: texturing.as_ref().is_some_and(|t| t.any_cut),
+            texturing,
             one_sided,
             materials,
             background: shade(scene.image.background),
@@ -466,7 +483,24 @@ impl<'a> Renderer<'a> {
         }
     }
 
+    /// The nearest hit along `ray`, through the gaps of cut-out textures
+    /// ([`Renderer::past_gaps`]).
+    #[inline(always)]
     pub(super) fn closest<C: Counter>(
+        &self,
+        ray: &PreparedRay,
+        query: &mut Query<C>,
+    ) -> Option<ClosestHit> {
+        let hit = self.nearest_surface(ray, query);
+        if self.cuts_out {
+            self.past_gaps(ray, hit, query)
+        } else {
+            hit
+        }
+    }
+
+    /// The nearest surface along `ray`, gaps or not.
+    pub(super) fn nearest_surface<C: Counter>(
         &self,
         ray: &PreparedRay,
         query: &mut Query<C>,
@@ -618,11 +652,11 @@ impl<'a> Renderer<'a> {
             }
             h.shape = shape;
         }
-        self.pass_through(crossings)
+        self.pass_through(&ray.ray, crossings)
     }
 
     /// The light a shadow ray's crossings let through.
-    pub(super) fn pass_through(&self, found: &ShadowCrossings) -> f64 {
+    pub(super) fn pass_through(&self, ray: &Ray, found: &ShadowCrossings) -> f64 {
         if found.is_blocked() {
             return 0.0;
         }
@@ -632,6 +666,10 @@ impl<'a> Renderer<'a> {
         let mut pass = 1.0;
         let mut previous: Option<(f64, u32)> = None;
         for &(t, shape) in found.transparent() {
+            // Light passes a cut-out's gaps untouched.
+            if self.cuts_out && self.crosses_gap(ray, shape, t) {
+                continue;
+            }
             let material = self.scene.shape_materials[shape as usize];
             let repeat = previous.is_some_and(|(pt, pm)| pm == material && t - pt <= same_place);
             if !repeat {

@@ -62,6 +62,12 @@ pub struct RenderStats {
     /// What loading had to say (unreadable material libraries, undefined
     /// material names).
     pub load_notes: Vec<String>,
+    /// The image textures the scene's materials use: each file, its size
+    /// and the bytes its decoded copy holds (left out when there are none).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub textures: Vec<TextureJson>,
+    /// Whether textures were drawn (`--textures`).
+    pub textures_drawn: bool,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub octree_stats: Option<OctreeStats>,
     /// With `--accel bvh`: what its build made (`build_s` is its build).
@@ -70,6 +76,14 @@ pub struct RenderStats {
     /// With `--view cost` or `cost-steps`: the per-pixel count's range.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cost_per_pixel: Option<CostJson>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct TextureJson {
+    pub path: String,
+    pub width: u32,
+    pub height: u32,
+    pub bytes: u64,
 }
 
 #[derive(Clone, Copy, Debug, Serialize)]
@@ -160,6 +174,17 @@ impl RenderStats {
             skipped_elements: scene.skipped_elements.clone(),
             not_rendered: scene.not_rendered.clone(),
             load_notes: scene.load_notes.clone(),
+            textures: scene
+                .textures
+                .iter()
+                .map(|t| TextureJson {
+                    path: t.path.display().to_string(),
+                    width: t.width,
+                    height: t.height,
+                    bytes: t.memory_bytes(),
+                })
+                .collect(),
+            textures_drawn: settings.textures,
             octree_stats: accel.octree().map(|t| t.stats()),
             bvh_stats: accel.bvh().map(|t| t.stats()),
             cost_per_pixel: frame.cost_summary().map(|c| CostJson {

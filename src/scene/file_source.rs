@@ -7,6 +7,14 @@ use std::path::Path;
 /// scenes embedded in the binary (and for the fuzz targets).
 pub trait FileSource {
     fn read(&self, path: &Path) -> std::io::Result<Vec<u8>>;
+
+    /// The names of the files in `folder`, for finding a texture whose
+    /// name differs in case from what its material file wrote (files
+    /// exported on Windows). Empty where there is no folder to list.
+    fn file_names(&self, folder: &Path) -> Vec<std::ffi::OsString> {
+        let _ = folder;
+        Vec::new()
+    }
 }
 
 pub struct FileSystem;
@@ -22,6 +30,17 @@ impl FileSource for FileSystem {
             ));
         }
         std::fs::read(path)
+    }
+
+    fn file_names(&self, folder: &Path) -> Vec<std::ffi::OsString> {
+        let folder = if folder.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            folder
+        };
+        std::fs::read_dir(folder)
+            .map(|entries| entries.flatten().map(|e| e.file_name()).collect())
+            .unwrap_or_default()
     }
 }
 
@@ -53,4 +72,26 @@ impl FileSource for Recording<'_> {
         }
         Ok(bytes)
     }
+
+    fn file_names(&self, folder: &Path) -> Vec<std::ffi::OsString> {
+        self.inner.file_names(folder)
+    }
+}
+
+/// A file a model names (a material library, a texture), as a path in the
+/// model's folder tree: `None` for an absolute path or one whose `..`
+/// climbs out of the folder. A model is something people share, and
+/// opening it must not read files elsewhere on the machine.
+pub(super) fn inside_folder(folder: &Path, written: &str) -> Option<std::path::PathBuf> {
+    use std::path::Component;
+    let mut depth = 0usize;
+    for component in Path::new(written).components() {
+        match component {
+            Component::Normal(_) => depth += 1,
+            Component::CurDir => {}
+            Component::ParentDir => depth = depth.checked_sub(1)?,
+            Component::RootDir | Component::Prefix(_) => return None,
+        }
+    }
+    Some(folder.join(written))
 }

@@ -1,7 +1,7 @@
 //! Wavefront OBJ meshes, placed by scale, rotation and translation (their
 //! MTL materials are `mesh_materials`'s).
 
-use super::obj::{self, NO_NORMAL, SkippedElements};
+use super::obj::{self, Corner, NO_NORMAL, SkippedElements};
 use super::polygon::{DroppedPolygons, PolygonDefect, triangulate};
 use crate::math::DVec3;
 
@@ -43,6 +43,9 @@ pub struct LoadedMesh {
     /// when the file has none, `None` for a triangle with a corner
     /// written without one.
     pub colors: Vec<Option<[DVec3; 3]>>,
+    /// Per-triangle texture coordinates (`vt`): empty when the file has
+    /// none, `None` for a triangle with a corner written without one.
+    pub uvs: Vec<Option<[[f64; 2]; 3]>>,
     /// Elements glint does not render, counted.
     pub skipped: SkippedElements,
 }
@@ -74,6 +77,7 @@ pub fn parse_obj(
     let mut triangle_normals = Vec::new();
     let mut triangle_materials = Vec::new();
     let mut triangle_colors = Vec::new();
+    let mut triangle_uvs = Vec::new();
     // Colours written 0-255 (some scanners) rather than 0-1: scaled.
     let color_scale = if data.colors.iter().flatten().any(|c| c.max_element() > 1.0) {
         1.0 / 255.0
@@ -92,7 +96,7 @@ pub fn parse_obj(
     let mut dropped_lines = Vec::new();
     let mut folded_quads = 0;
     let mut skipped = data.skipped.clone();
-    let mut face: Vec<(u32, u32)> = Vec::new();
+    let mut face: Vec<Corner> = Vec::new();
     for f in &data.faces {
         // Repeated vertices removed (the first of each kept): a face that
         // lists its four corners 234 times is a quad, not 936 triangles.
@@ -104,11 +108,11 @@ pub fn parse_obj(
             .then(|| keyhole_face(listed, &positions))
             .flatten();
         // The triangles, as indices into the corners they use.
-        let (pieces, used): (Vec<[u32; 3]>, &[(u32, u32)]) = match keyhole {
+        let (pieces, used): (Vec<[u32; 3]>, &[Corner]) = match keyhole {
             Some(pieces) => (pieces, listed),
             None => {
                 for &corner in listed {
-                    if !face.iter().any(|&(p, _)| p == corner.0) {
+                    if !face.iter().any(|c| c.position == corner.position) {
                         face.push(corner);
                     }
                 }
@@ -121,8 +125,10 @@ pub fn parse_obj(
                 if face.len() < listed.len() {
                     skipped.faces_with_repeated_vertices += 1;
                 }
-                let corners: Vec<DVec3> =
-                    face.iter().map(|&(p, _)| positions[p as usize]).collect();
+                let corners: Vec<DVec3> = face
+                    .iter()
+                    .map(|c| positions[c.position as usize])
+                    .collect();
                 let pieces = if face.len() == 3 {
                     vec![[0, 1, 2]]
                 } else {
@@ -152,20 +158,24 @@ pub fn parse_obj(
                 (pieces, &face[..])
             }
         };
-        let has_normals = used.iter().all(|&(_, n)| n != NO_NORMAL);
+        let has_normals = used.iter().all(|c| c.normal != NO_NORMAL);
         any_normals |= has_normals;
+        let has_uvs = used.iter().all(|c| c.uv != NO_NORMAL);
         for t in pieces {
             let corners = t.map(|k| used[k as usize]);
-            triangles.push(corners.map(|(p, _)| positions[p as usize]));
+            triangles.push(corners.map(|c| positions[c.position as usize]));
             triangle_normals.push(if has_normals {
-                corners.map(|(_, n)| normals[n as usize])
+                corners.map(|c| normals[c.normal as usize])
             } else {
                 [DVec3::ZERO; 3]
             });
             triangle_materials.push(f.material);
             if !data.colors.is_empty() {
-                let [ca, cb, cc] = corners.map(|(p, _)| color_of(p));
+                let [ca, cb, cc] = corners.map(|c| color_of(c.position));
                 triangle_colors.push(ca.zip(cb).zip(cc).map(|((a, b), c)| [a, b, c]));
+            }
+            if !data.uvs.is_empty() {
+                triangle_uvs.push(has_uvs.then(|| corners.map(|c| data.uvs[c.uv as usize])));
             }
         }
     }
@@ -205,14 +215,15 @@ pub fn parse_obj(
         dropped_lines,
         folded_quads,
         colors: triangle_colors,
+        uvs: triangle_uvs,
         skipped,
     })
 }
 
 /// A keyhole face's triangles (indices into `listed`), if it is one: its
 /// corners repeat a vertex, in the `a b … b a` pattern of a bridge.
-fn keyhole_face(listed: &[(u32, u32)], positions: &[DVec3]) -> Option<Vec<[u32; 3]>> {
-    let ids: Vec<u32> = listed.iter().map(|&(p, _)| p).collect();
+fn keyhole_face(listed: &[Corner], positions: &[DVec3]) -> Option<Vec<[u32; 3]>> {
+    let ids: Vec<u32> = listed.iter().map(|c| c.position).collect();
     let corners: Vec<DVec3> = ids.iter().map(|&p| positions[p as usize]).collect();
     super::keyhole::triangulate_keyhole(&ids, &corners)
 }

@@ -6,11 +6,12 @@
 
 use std::path::Path;
 
-use super::file_source::FileSource;
+use super::file_source::{FileSource, inside_folder};
 use super::mesh::LoadedMesh;
 use super::model::Scene;
 use super::mtl::{self, MtlEntry};
 use crate::material::Material;
+use crate::texture::{Channel, TextureMap};
 
 /// The materials of an OBJ file's `mtllib` libraries, read through `files`
 /// relative to `obj_path`'s folder; a library that cannot be read or parsed
@@ -67,24 +68,6 @@ pub(super) fn read_libraries(
     entries
 }
 
-/// A library named in an `mtllib` line, as a path in the model's folder
-/// tree: `None` for an absolute path or one whose `..` climbs out of the
-/// folder. A model is something people share, and its material libraries
-/// must not read files elsewhere on the machine that opens it.
-fn inside_folder(folder: &Path, written: &str) -> Option<std::path::PathBuf> {
-    use std::path::Component;
-    let mut depth = 0usize;
-    for component in Path::new(written).components() {
-        match component {
-            Component::Normal(_) => depth += 1,
-            Component::CurDir => {}
-            Component::ParentDir => depth = depth.checked_sub(1)?,
-            Component::RootDir | Component::Prefix(_) => return None,
-        }
-    }
-    Some(folder.join(written))
-}
-
 /// The scene's material index for each of `mesh`'s `usemtl` slots: its
 /// libraries' materials, added to the scene once each (named after the
 /// MTL, made unique), and the default material for faces with none or
@@ -117,6 +100,10 @@ pub(super) fn mesh_materials(
     // Notes many materials share ("Ns -1.96 used as no highlight" for 17
     // of them) are said once, naming the materials.
     let mut grouped: std::collections::BTreeMap<String, Vec<String>> = Default::default();
+    // Textures that could not be read, said once each with the materials
+    // that name them.
+    let mut unread_textures: std::collections::BTreeMap<String, Vec<String>> = Default::default();
+    let mut textured_without_uvs = Vec::new();
     let used: Vec<bool> = {
         let mut used = vec![false; mesh.material_names.len()];
         for &m in &mesh.triangle_materials {
@@ -143,7 +130,48 @@ pub(super) fn mesh_materials(
                         .or_default()
                         .push(e.name.clone());
                 }
-                let material = e.to_material(e.name.clone());
+                let mut material = e.to_material(e.name.clone());
+                let folder = e.library.parent().unwrap_or(Path::new(""));
+                for (spec, channel) in [(&e.map_kd, Channel::Color), (&e.map_d, Channel::Value)] {
+                    let Some(spec) = spec else { continue };
+                    let keyword = match channel {
+                        Channel::Color => "map_Kd",
+                        Channel::Value => "map_d",
+                    };
+                    match super::textures::texture_index(scene, folder, &spec.file, files) {
+                        Ok(texture) => {
+                            let map = TextureMap {
+                                texture,
+                                name: spec.file.clone(),
+                                scale: spec.scale,
+                                offset: spec.offset,
+                                clamp: spec.clamp,
+                                channel,
+                            };
+                            if channel == Channel::Value {
+                                material.cutout_map = Some(map);
+                            } else {
+                                // A colour map's alpha cuts out unless a
+                                // `map_d` says what does.
+                                if scene.textures[texture as usize].has_alpha && e.map_d.is_none() {
+                                    material.cutout_map = Some(map.clone());
+                                }
+                                material.color_map = Some(map);
+                            }
+                            if mesh.uvs.is_empty() && textured_without_uvs.last() != Some(&e.name) {
+                                textured_without_uvs.push(e.name.clone());
+                            }
+                        }
+                        Err(reason) => unread_textures
+                            .entry(format!(
+                                "{}: texture `{}` ({keyword}) cannot be read: {reason}",
+                                e.library.display(),
+                                spec.file
+                            ))
+                            .or_default()
+                            .push(e.name.clone()),
+                    }
+                }
                 // `d 0` on a surface that does not refract: a ghost (glass,
                 // `illum 6` or `7`, is meant to be see-through).
                 let refracts = matches!(e.illum, Some(6 | 7));
@@ -180,6 +208,31 @@ pub(super) fn mesh_materials(
             }
         };
         slots.push(index);
+    }
+    for (note, names) in unread_textures {
+        let named = names
+            .iter()
+            .map(|n| format!("`{n}`"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        scene.load_notes.push(format!(
+            "{note}; {} {named} {} drawn in {} own `Kd` colour",
+            if names.len() == 1 {
+                "material"
+            } else {
+                "materials"
+            },
+            if names.len() == 1 { "is" } else { "are" },
+            if names.len() == 1 { "its" } else { "their" },
+        ));
+    }
+    if !textured_without_uvs.is_empty() {
+        grouped
+            .entry(
+                "textured, but the mesh has no texture coordinates (`vt`): drawn untextured".into(),
+            )
+            .or_default()
+            .extend(textured_without_uvs);
     }
     for (note, names) in grouped {
         let named = names

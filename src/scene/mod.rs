@@ -16,6 +16,7 @@ mod obj_scene;
 pub mod polygon;
 pub mod save;
 mod text;
+mod textures;
 pub mod toml_format;
 
 use std::path::Path;

@@ -80,6 +80,14 @@ pub struct Scene {
     /// shapes past the end have none): the colour replaces the material's
     /// diffuse colour, interpolated across the face.
     pub shape_colors: Arc<Vec<u32>>,
+    /// Per-triangle texture coordinates (an OBJ's `vt`, a TOML triangle's
+    /// `uvs`), for the materials' textures.
+    pub vertex_uvs: Arc<Vec<[[f64; 2]; 3]>>,
+    /// For each shape, its entry in `vertex_uvs` (`u32::MAX`: none; shapes
+    /// past the end have none): a shape without one is drawn untextured.
+    pub shape_uvs: Arc<Vec<u32>>,
+    /// The images materials' texture maps name, each file decoded once.
+    pub textures: Vec<Arc<crate::texture::Texture>>,
     /// Degenerate triangles dropped while loading (they could never be hit).
     pub dropped_triangles: usize,
     /// Polygons dropped while loading: zero area, or not simple.
@@ -164,6 +172,7 @@ impl Scene {
             sides: self.image.sides,
             adaptive: self.image.adaptive,
             shadows: true,
+            textures: true,
         }
     }
 
@@ -183,6 +192,9 @@ impl Scene {
             vertex_normals: Arc::default(),
             vertex_colors: Arc::default(),
             shape_colors: Arc::default(),
+            vertex_uvs: Arc::default(),
+            shape_uvs: Arc::default(),
+            textures: Vec::new(),
             dropped_triangles: 0,
             dropped_polygons: DroppedPolygons::default(),
             skipped_elements: SkippedElements::default(),
@@ -273,27 +285,64 @@ impl Scene {
         Arc::make_mut(&mut self.shape_materials).push(material);
     }
 
-    /// Adds triangles (with optional per-triangle vertex normals), each
-    /// with the material `material(i)`, dropping degenerate ones.
+    /// Adds triangles (with optional per-triangle vertex normals, colours
+    /// and texture coordinates), each with the material `material(i)`,
+    /// dropping degenerate ones.
     pub(crate) fn push_mesh(
         &mut self,
         triangles: Vec<[DVec3; 3]>,
         normals: Option<Vec<[DVec3; 3]>>,
         colors: &[Option<[DVec3; 3]>],
+        uvs: &[Option<[[f64; 2]; 3]>],
         material: impl Fn(usize) -> u32,
     ) {
         for (i, vertices) in triangles.into_iter().enumerate() {
             let before = self.shapes.len();
             self.push_triangle(vertices, normals.as_ref().map(|n| n[i]), material(i));
-            if let Some(Some(c)) = colors.get(i)
-                && self.shapes.len() > before
-            {
+            if self.shapes.len() == before {
+                continue;
+            }
+            if let Some(Some(c)) = colors.get(i) {
                 let shape_colors = Arc::make_mut(&mut self.shape_colors);
                 shape_colors.resize(before, u32::MAX);
                 shape_colors.push(self.vertex_colors.len() as u32);
                 Arc::make_mut(&mut self.vertex_colors).push(*c);
             }
+            if let Some(Some(uv)) = uvs.get(i) {
+                self.set_uvs(before, *uv);
+            }
         }
+    }
+
+    /// Gives shape `shape` (a triangle) the texture coordinates `uv` of
+    /// its three corners.
+    pub(crate) fn set_uvs(&mut self, shape: usize, uv: [[f64; 2]; 3]) {
+        let shape_uvs = Arc::make_mut(&mut self.shape_uvs);
+        shape_uvs.resize(shape.max(shape_uvs.len()), u32::MAX);
+        let entry = self.vertex_uvs.len() as u32;
+        match shape_uvs.get_mut(shape) {
+            Some(slot) => *slot = entry,
+            None => shape_uvs.push(entry),
+        }
+        Arc::make_mut(&mut self.vertex_uvs).push(uv);
+    }
+
+    /// Bytes the decoded textures hold.
+    pub fn texture_bytes(&self) -> u64 {
+        self.textures.iter().map(|t| t.memory_bytes()).sum()
+    }
+
+    /// The texture coordinates of triangle `shape` at barycentric
+    /// coordinates `(b1, b2)`, if it has them.
+    #[inline]
+    pub fn uv_at(&self, shape: u32, b1: f64, b2: f64) -> Option<[f64; 2]> {
+        let &entry = self.shape_uvs.get(shape as usize)?;
+        let [t0, t1, t2] = self.vertex_uvs.get(entry as usize)?;
+        let b0 = 1.0 - b1 - b2;
+        Some([
+            b0 * t0[0] + b1 * t1[0] + b2 * t2[0],
+            b0 * t0[1] + b1 * t1[1] + b2 * t2[1],
+        ])
     }
 
     /// Adds one triangle, or counts it as dropped if it is degenerate.
@@ -472,6 +521,7 @@ mod tests {
             vec![triangle; lengths.len()],
             Some(normals.to_vec()),
             &[],
+            &[],
             |_| 0,
         );
         assert_eq!(scene.vertex_normals.len(), lengths.len());
@@ -488,6 +538,7 @@ mod tests {
             scene.push_mesh(
                 vec![triangle],
                 Some(vec![[DVec3::Z, bad, DVec3::Z]]),
+                &[],
                 &[],
                 |_| 0,
             );

@@ -17,7 +17,11 @@
 //! | `illum 4, 6, 7, 9` | also reflection and transparency; 6 and 7 refract (7's Fresnel term is not modelled) |
 //! | `illum 10` | as 1 |
 //!
-//! Texture maps, bump and displacement, emission (`Ke`) and the PBR
+//! | `map_Kd` | `color_map`: the texture's colour multiplies `Kd` (as the specification says), its alpha (where it has one) cuts the surface away ([`crate::texture`]) |
+//! | `map_d` | `cutout_map`: the surface is cut away where the map's alpha (or grey level) is below one half |
+//! | `-s`, `-o`, `-clamp` of a map | the lookup at `uv * s + o`; one copy of the image, not repeated, with `-clamp on` |
+//!
+//! Other texture maps, bump and displacement, emission (`Ke`) and the PBR
 //! extension keys are not rendered: they are listed, never dropped silently.
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -43,8 +47,82 @@ pub(super) struct MtlEntry {
     /// The library file the entry is in, for notes.
     pub library: std::path::PathBuf,
     pub illum: Option<u32>,
+    /// `map_Kd` and `map_d` as written.
+    pub map_kd: Option<MapSpec>,
+    pub map_d: Option<MapSpec>,
     /// Keywords glint does not render, as written (`map_Kd`, `bump`, ...).
     pub not_rendered: BTreeSet<String>,
+}
+
+/// A texture map statement: the file it names (as written) and its options.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct MapSpec {
+    pub file: String,
+    pub scale: [f64; 2],
+    pub offset: [f64; 2],
+    pub clamp: bool,
+}
+
+impl MapSpec {
+    /// Reads `[options] file` of a map statement. Options glint does not
+    /// use are skipped with their arguments; the file name is the rest of
+    /// the line, spaces and all.
+    fn parse(rest: &str) -> Result<Self, String> {
+        let mut spec = MapSpec {
+            file: String::new(),
+            scale: [1.0, 1.0],
+            offset: [0.0, 0.0],
+            clamp: false,
+        };
+        let mut rest = rest.trim();
+        // Whether `word` opens an option (a dash and a letter, not `-0.5`).
+        let is_option = |word: &str| {
+            word.starts_with('-') && word[1..].starts_with(|c: char| c.is_ascii_alphabetic())
+        };
+        while let Some(word) = rest.split_whitespace().next().filter(|w| is_option(w)) {
+            rest = rest[word.len()..].trim_start();
+            // How many words follow it: up to three numbers for `-s`, `-o`,
+            // `-t`, `-mm`, one word for the rest.
+            let takes_numbers = matches!(word, "-s" | "-o" | "-t" | "-mm");
+            let mut args = Vec::new();
+            while let Some(next) = rest.split_whitespace().next() {
+                let number = next.parse::<f64>().ok();
+                let wanted = if takes_numbers {
+                    number.is_some() && args.len() < 3
+                } else {
+                    args.is_empty()
+                };
+                if !wanted {
+                    break;
+                }
+                args.push(next.to_owned());
+                rest = rest[next.len()..].trim_start();
+            }
+            let numbers: Vec<f64> = args.iter().filter_map(|a| a.parse().ok()).collect();
+            let pair = |default: f64| -> Result<[f64; 2], String> {
+                let first = *numbers
+                    .first()
+                    .ok_or_else(|| format!("`{word}` needs a number"))?;
+                let v = [first, numbers.get(1).copied().unwrap_or(default)];
+                if v.iter().all(|x| x.is_finite()) {
+                    Ok(v)
+                } else {
+                    Err(format!("`{word}` needs finite numbers"))
+                }
+            };
+            match word {
+                "-s" => spec.scale = pair(1.0)?,
+                "-o" => spec.offset = pair(0.0)?,
+                "-clamp" => spec.clamp = args.first().is_some_and(|a| a == "on"),
+                _ => {}
+            }
+        }
+        if rest.is_empty() {
+            return Err("names no file".into());
+        }
+        spec.file = rest.to_owned();
+        Ok(spec)
+    }
 }
 
 /// Keywords read but deliberately without effect: ambient colour (glint's
@@ -153,6 +231,15 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Vec<MtlEntry>, ObjError> {
                 }
                 entry.illum = Some(i as u32);
             }
+            "map_Kd" | "map_d" => {
+                let spec = MapSpec::parse(&String::from_utf8_lossy(rest))
+                    .map_err(|e| err(format!("`{keyword}` {e}")))?;
+                if keyword == "map_Kd" {
+                    entry.map_kd = Some(spec);
+                } else {
+                    entry.map_d = Some(spec);
+                }
+            }
             // Emission of zero is what most exporters write for "none".
             "Ke" if color()?.is_some_and(|c| c == DVec3::ZERO) => {}
             k if IGNORED.contains(&k) => {}
@@ -213,6 +300,9 @@ impl MtlEntry {
             } else {
                 1.0
             },
+            // The maps are files: `mesh_materials` reads them.
+            color_map: None,
+            cutout_map: None,
         }
     }
 }
@@ -384,9 +474,32 @@ bump tint_n.png
             material.validate().unwrap();
         }
         let listed = not_rendered(&entries);
-        assert_eq!(listed["map_Kd"], 2);
+        assert!(!listed.contains_key("map_Kd"));
+        assert_eq!(entries[3].map_kd.as_ref().unwrap().file, "tint.png");
         assert_eq!(listed["bump"], 1);
         assert!(!listed.contains_key("Ke") && !listed.contains_key("Ka"));
+    }
+
+    #[test]
+    fn map_options_are_read_and_the_file_is_the_rest_of_the_line() {
+        let entries = parse(
+            b"newmtl a\nmap_Kd -s 2 3 1 -o 0.5 -bm 0.2 -clamp on -imfchan m my wood.jpg\n\
+              map_d -o -0.25 0.5 leaf.tga\n",
+        )
+        .unwrap();
+        let kd = entries[0].map_kd.as_ref().unwrap();
+        assert_eq!(kd.file, "my wood.jpg");
+        assert_eq!(
+            (kd.scale, kd.offset, kd.clamp),
+            ([2.0, 3.0], [0.5, 0.0], true)
+        );
+        let d = entries[0].map_d.as_ref().unwrap();
+        assert_eq!((d.file.as_str(), d.offset), ("leaf.tga", [-0.25, 0.5]));
+        let e = parse(b"newmtl a\nmap_Kd -s 2\n").unwrap_err();
+        assert_eq!(e.line, 2);
+        assert!(e.message.contains("names no file"), "{e}");
+        let e = parse(b"newmtl a\nmap_Kd -o x.png\n").unwrap_err();
+        assert!(e.message.contains("`-o` needs a number"), "{e}");
     }
 
     #[test]

@@ -281,6 +281,8 @@ fn parse_into(
                     reflectivity: ks,
                     transparency,
                     ior,
+                    color_map: None,
+                    cutout_map: None,
                 };
                 let same = |o: &Material| {
                     (o.color, o.kd, o.ks, o.shininess, o.transparency, o.ior)

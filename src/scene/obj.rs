@@ -1,6 +1,7 @@
-//! Wavefront OBJ statements, read by glint itself: positions and normals in
-//! f64, faces of any size with their `usemtl` material, the `mtllib` names,
-//! and a count of everything else a file may hold.
+//! Wavefront OBJ statements, read by glint itself: positions, normals and
+//! texture coordinates in f64, faces of any size with their `usemtl`
+//! material, the `mtllib` names, and a count of everything else a file may
+//! hold.
 //!
 //! A general-purpose loader gave no line numbers, read coordinates in f32,
 //! refused a whole file over one Latin-1 material name or an empty `usemtl`,
@@ -13,8 +14,21 @@ use std::collections::BTreeMap;
 
 use crate::math::DVec3;
 
-/// No normal given for a face corner.
+/// No normal (or texture coordinate) given for a face corner.
 pub(super) const NO_NORMAL: u32 = u32::MAX;
+
+/// A texture coordinate index that cannot exist (zero, or counting back
+/// past the first `vt`): checked and counted with the others.
+const NO_SUCH_UV: u32 = u32::MAX - 1;
+
+/// One corner of a face: zero-based indices of its position, its normal
+/// and its texture coordinates (`NO_NORMAL` where not given).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct Corner {
+    pub position: u32,
+    pub normal: u32,
+    pub uv: u32,
+}
 
 /// One `f` element: `len` corners from `start` in [`ObjData::corners`].
 #[derive(Clone, Copy, Debug)]
@@ -35,9 +49,10 @@ pub(super) struct ObjData {
     /// the file has none, `None` for a vertex written without one.
     pub colors: Vec<Option<DVec3>>,
     pub normals: Vec<DVec3>,
-    /// Every face's corners: (position index, normal index or `NO_NORMAL`),
-    /// zero-based and checked against the final vertex counts.
-    pub corners: Vec<(u32, u32)>,
+    /// `vt` texture coordinates (u, v); a `w` is ignored.
+    pub uvs: Vec<[f64; 2]>,
+    /// Every face's corners, checked against the final vertex counts.
+    pub corners: Vec<Corner>,
     pub faces: Vec<Face>,
     /// Material names in order of first `usemtl`; index 0 is the faces
     /// before any `usemtl` (or after an empty one): the default material.
@@ -62,6 +77,10 @@ pub struct SkippedElements {
     /// Faces whose normal indices point past the file's normals: shaded
     /// without them.
     pub faces_with_missing_normals: usize,
+    /// Faces whose texture coordinate indices point past the file's `vt`
+    /// lines: drawn untextured.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub faces_with_missing_uvs: usize,
     /// Other statements (free-form curves and surfaces, display attributes),
     /// by keyword.
     pub statements: BTreeMap<String, usize>,
@@ -198,6 +217,23 @@ pub(super) fn parse(bytes: &[u8]) -> Result<ObjData, ObjError> {
                     data.normals.push(p);
                 }
             }
+            b"vt" => {
+                let mut uv = [0.0; 2];
+                // `vt u [v [w]]`: v defaults to 0, w (3D textures) is ignored.
+                for (k, value) in uv.iter_mut().enumerate() {
+                    match args.next() {
+                        Some(token) => {
+                            *value =
+                                number_of(token).filter(|x| x.is_finite()).ok_or_else(|| {
+                                    err(format!("`{}` is not a finite number", lossy(token)))
+                                })?
+                        }
+                        None if k == 0 => return Err(err("`vt` needs a coordinate".into())),
+                        None => {}
+                    }
+                }
+                data.uvs.push(uv);
+            }
             b"f" | b"fo" => {
                 let start = data.corners.len();
                 for token in args {
@@ -228,9 +264,9 @@ pub(super) fn parse(bytes: &[u8]) -> Result<ObjData, ObjError> {
             b"mtllib" => data.libraries.push(rest_of_line(content, keyword_len)),
             b"l" => data.skipped.lines += 1,
             b"p" => data.skipped.points += 1,
-            // Texture coordinates, groups, objects and smoothing groups:
-            // nothing glint renders depends on them.
-            b"vt" | b"g" | b"o" | b"s" => {}
+            // Groups, objects and smoothing groups: nothing glint renders
+            // depends on them.
+            b"g" | b"o" | b"s" => {}
             other => {
                 *data
                     .skipped
@@ -243,25 +279,29 @@ pub(super) fn parse(bytes: &[u8]) -> Result<ObjData, ObjError> {
     // Check the indices now that every vertex is known. A face whose
     // normals do not exist is kept without them (exporters write `i//n`
     // with no `vn`); a missing vertex leaves nothing to draw.
-    let (positions, normals) = (data.positions.len(), data.normals.len());
+    let (positions, normals, uvs) = (data.positions.len(), data.normals.len(), data.uvs.len());
     for (face, &line) in data.faces.iter().zip(&last_line_of_face) {
         let corners = &mut data.corners[face.start as usize..(face.start + face.len) as usize];
-        if let Some(&(p, _)) = corners.iter().find(|(p, _)| *p as usize >= positions) {
+        if let Some(c) = corners.iter().find(|c| c.position as usize >= positions) {
             return Err(ObjError {
                 line,
                 message: format!(
                     "vertex index {} is out of range (the file has {positions} vertices)",
-                    p as u64 + 1
+                    c.position as u64 + 1
                 ),
             });
         }
-        if corners
-            .iter()
-            .any(|&(_, n)| n != NO_NORMAL && n as usize >= normals)
-        {
+        let missing = |index: u32, count: usize| index != NO_NORMAL && index as usize >= count;
+        if corners.iter().any(|c| missing(c.normal, normals)) {
             data.skipped.faces_with_missing_normals += 1;
             for corner in corners.iter_mut() {
-                corner.1 = NO_NORMAL;
+                corner.normal = NO_NORMAL;
+            }
+        }
+        if corners.iter().any(|c| missing(c.uv, uvs)) {
+            data.skipped.faces_with_missing_uvs += 1;
+            for corner in corners.iter_mut() {
+                corner.uv = NO_NORMAL;
             }
         }
     }
@@ -269,6 +309,10 @@ pub(super) fn parse(bytes: &[u8]) -> Result<ObjData, ObjError> {
         data.colors.resize(data.positions.len(), None);
     }
     Ok(data)
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 fn lossy(token: &[u8]) -> String {
@@ -281,7 +325,7 @@ fn number_of(token: &[u8]) -> Option<f64> {
 
 /// A face corner `i`, `i/t`, `i//n` or `i/t/n`, zero-based; negative
 /// indices count back from the vertices read so far.
-fn corner_of(token: &[u8], data: &ObjData) -> Result<(u32, u32), String> {
+fn corner_of(token: &[u8], data: &ObjData) -> Result<Corner, String> {
     let mut parts = token.split(|&b| b == b'/');
     let bad = || {
         format!(
@@ -290,7 +334,7 @@ fn corner_of(token: &[u8], data: &ObjData) -> Result<(u32, u32), String> {
         )
     };
     let position = parts.next().ok_or_else(bad)?;
-    let _texture = parts.next();
+    let texture = parts.next();
     let normal = parts.next();
     if parts.next().is_some() {
         return Err(bad());
@@ -317,7 +361,19 @@ fn corner_of(token: &[u8], data: &ObjData) -> Result<(u32, u32), String> {
         Some(n) if !n.is_empty() => resolve(n, data.normals.len(), "normal")?,
         _ => NO_NORMAL,
     };
-    Ok((p, n))
+    // Texture coordinates that do not exist leave the face untextured
+    // (counted) rather than refuse a model that renders without them.
+    let t = match texture {
+        Some(t) if !t.is_empty() => {
+            resolve(t, data.uvs.len(), "texture coordinate").unwrap_or(NO_SUCH_UV)
+        }
+        _ => NO_NORMAL,
+    };
+    Ok(Corner {
+        position: p,
+        normal: n,
+        uv: t,
+    })
 }
 
 #[cfg(test)]
@@ -329,12 +385,18 @@ mod tests {
         let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1 2 3\nf 1/1 2/2 3/3\nf 1//1 2//1 3//1\nf -3/1/1 -2/2/1 -1/3/1\n";
         let data = parse(text.as_bytes()).unwrap();
         assert_eq!(data.faces.len(), 4);
+        let pn = |d: &ObjData, r: std::ops::Range<usize>| -> Vec<(u32, u32)> {
+            d.corners[r]
+                .iter()
+                .map(|c| (c.position, c.normal))
+                .collect()
+        };
         assert_eq!(
-            &data.corners[0..3],
-            &[(0, NO_NORMAL), (1, NO_NORMAL), (2, NO_NORMAL)]
+            pn(&data, 0..3),
+            [(0, NO_NORMAL), (1, NO_NORMAL), (2, NO_NORMAL)]
         );
-        assert_eq!(&data.corners[6..9], &[(0, 0), (1, 0), (2, 0)]);
-        assert_eq!(&data.corners[9..12], &[(0, 0), (1, 0), (2, 0)]);
+        assert_eq!(pn(&data, 6..9), [(0, 0), (1, 0), (2, 0)]);
+        assert_eq!(pn(&data, 9..12), [(0, 0), (1, 0), (2, 0)]);
     }
 
     #[test]
@@ -399,11 +461,22 @@ mod tests {
             parse(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//2\nf 1//1 2//1 3//1\n")
                 .unwrap();
         assert_eq!(data.skipped.faces_with_missing_normals, 1);
-        assert_eq!(
-            &data.corners[0..3],
-            &[(0, NO_NORMAL), (1, NO_NORMAL), (2, NO_NORMAL)]
-        );
-        assert_eq!(&data.corners[3..6], &[(0, 0), (1, 0), (2, 0)]);
+        let normals: Vec<u32> = data.corners.iter().map(|c| c.normal).collect();
+        assert_eq!(normals, [NO_NORMAL, NO_NORMAL, NO_NORMAL, 0, 0, 0]);
+    }
+
+    #[test]
+    fn texture_coordinates_by_index_and_counted_back_and_missing_ones_dropped() {
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.5\nvt 1 0.25 7\nvt 0 1\n\
+                    f 1/1 2/2 3/3\nf 1/-1/ 2/-2 3/-3\nf 1/1 2/2 3/9\nf 1/-9 2/1 3/1\n";
+        let data = parse(text.as_bytes()).unwrap();
+        assert_eq!(data.uvs, [[0.5, 0.0], [1.0, 0.25], [0.0, 1.0]]);
+        let uvs: Vec<u32> = data.corners.iter().map(|c| c.uv).collect();
+        assert_eq!(uvs[..6], [0, 1, 2, 2, 1, 0]);
+        assert!(uvs[6..].iter().all(|&t| t == NO_NORMAL));
+        assert_eq!(data.skipped.faces_with_missing_uvs, 2);
+        let e = parse(b"vt x\n").unwrap_err();
+        assert!(e.message.contains("`x` is not a finite number"), "{e}");
     }
 
     #[test]

@@ -90,6 +90,10 @@ struct MaterialFile {
     reflectivity: Option<Spanned<f64>>,
     transparency: Option<Spanned<f64>>,
     ior: Option<Spanned<f64>>,
+    /// An image file (relative to the scene file) whose colour multiplies
+    /// `color` on triangles with texture coordinates, and whose alpha, if it
+    /// has one, cuts them out.
+    texture: Option<Spanned<String>>,
 }
 
 #[derive(Deserialize)]
@@ -118,6 +122,8 @@ struct ObjectFile {
     point: Option<Vec3>,
     normal: Option<Vec3>,
     vertices: Option<Spanned<[[f64; 3]; 3]>>,
+    /// A triangle's texture coordinates, one `[u, v]` per vertex.
+    uvs: Option<Spanned<[[f64; 2]; 3]>>,
     coefficients: Option<Spanned<[f64; 10]>>,
     clip: Option<Spanned<ClipFile>>,
     path: Option<Spanned<String>>,
@@ -171,6 +177,32 @@ impl Context<'_> {
             }
         }
         Ok(mat)
+    }
+
+    /// Puts the texture `m` names, if any, on the scene's material
+    /// `index`: read relative to the scene file, an error at its key if it
+    /// cannot be read or decoded.
+    fn texture(
+        &self,
+        scene: &mut Scene,
+        index: usize,
+        m: &MaterialFile,
+        prefix: &str,
+        files: &dyn FileSource,
+    ) -> Result<(), SceneError> {
+        let Some(name) = &m.texture else {
+            return Ok(());
+        };
+        let folder = self.path.parent().unwrap_or(Path::new(""));
+        let texture = super::textures::texture_index(scene, folder, name.get_ref(), files)
+            .map_err(|e| self.error(name.span(), &format!("{prefix}.texture"), e))?;
+        let map = crate::texture::TextureMap::new(texture, name.get_ref().clone());
+        let material = &mut scene.materials[index];
+        material.cutout_map = scene.textures[texture as usize]
+            .has_alpha
+            .then(|| map.clone());
+        material.color_map = Some(map);
+        Ok(())
     }
 }
 
@@ -311,6 +343,9 @@ fn parse_file(
     scene.octree_params = octree_params;
     cx.defined_materials = materials.len();
     scene.materials = materials;
+    for (index, (name, m)) in file.materials.iter().enumerate() {
+        cx.texture(&mut scene, index, m, &format!("materials.{name}"), files)?;
+    }
     scene.lights = lights;
     for (i, obj) in file.objects.iter().enumerate() {
         add_object(cx, &mut scene, i, obj, files)?;
@@ -376,7 +411,7 @@ fn add_object(
     let allowed: &[&str] = match kind {
         "sphere" => &["center", "radius"],
         "plane" => &["point", "normal"],
-        "triangle" => &["vertices"],
+        "triangle" => &["vertices", "uvs"],
         "quadric" => &["coefficients", "clip"],
         "mesh" => &[
             "path",
@@ -396,12 +431,13 @@ fn add_object(
             ));
         }
     };
-    let present: [(&str, Option<Range<usize>>); 13] = [
+    let present: [(&str, Option<Range<usize>>); 14] = [
         ("center", obj.center.as_ref().map(Spanned::span)),
         ("radius", obj.radius.as_ref().map(Spanned::span)),
         ("point", obj.point.as_ref().map(Spanned::span)),
         ("normal", obj.normal.as_ref().map(Spanned::span)),
         ("vertices", obj.vertices.as_ref().map(Spanned::span)),
+        ("uvs", obj.uvs.as_ref().map(Spanned::span)),
         ("coefficients", obj.coefficients.as_ref().map(Spanned::span)),
         ("clip", obj.clip.as_ref().map(Spanned::span)),
         ("path", obj.path.as_ref().map(Spanned::span)),
@@ -471,8 +507,19 @@ fn add_object(
             if !vertices.iter().all(|p| p.is_finite()) {
                 return Err(cx.error(v.span(), &key("vertices"), "must be finite numbers"));
             }
+            let uvs = match &obj.uvs {
+                Some(t) if !t.get_ref().iter().flatten().all(|x| x.is_finite()) => {
+                    return Err(cx.error(t.span(), &key("uvs"), "must be finite numbers"));
+                }
+                t => t.as_ref().map(|t| *t.get_ref()),
+            };
             match Triangle::new(vertices) {
-                Some(t) => scene.push(Shape::Triangle(t), material),
+                Some(t) => {
+                    scene.push(Shape::Triangle(t), material);
+                    if let Some(uvs) = uvs {
+                        scene.set_uvs(scene.shapes.len() - 1, uvs);
+                    }
+                }
                 None => scene.dropped_triangles += 1,
             }
         }
@@ -592,7 +639,13 @@ fn add_object(
                         "`materials` changes a mesh's own materials; with `material` it has none",
                     ));
                 }
-                scene.push_mesh(mesh.triangles, mesh.normals, &mesh.colors, |_| material);
+                scene.push_mesh(
+                    mesh.triangles,
+                    mesh.normals,
+                    &mesh.colors,
+                    &mesh.uvs,
+                    |_| material,
+                );
             } else {
                 let (slots, default) =
                     super::mesh_materials::mesh_materials(scene, &mesh, &mesh_path, files);
@@ -621,6 +674,7 @@ fn add_object(
                         for i in targets {
                             let base = scene.materials[i as usize].clone();
                             scene.materials[i as usize] = cx.material(base, m, &prefix)?;
+                            cx.texture(scene, i as usize, m, &prefix, files)?;
                         }
                     }
                 }
@@ -634,7 +688,7 @@ fn add_object(
                         }
                     }));
                 let per_triangle = &mesh.triangle_materials;
-                scene.push_mesh(mesh.triangles, mesh.normals, &mesh.colors, |i| {
+                scene.push_mesh(mesh.triangles, mesh.normals, &mesh.colors, &mesh.uvs, |i| {
                     slots[per_triangle[i] as usize]
                 });
             }

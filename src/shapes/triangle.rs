@@ -115,6 +115,31 @@ impl Triangle {
         Aabb::from_points(&self.vertices)
     }
 
+    /// The point at barycentric coordinates `(b1, b2)`.
+    #[inline]
+    pub fn point_at(&self, b1: f64, b2: f64) -> DVec3 {
+        let [v0, v1, v2] = self.vertices;
+        (1.0 - b1 - b2) * v0 + b1 * v1 + b2 * v2
+    }
+
+    /// The barycentric coordinates `(b1, b2)` of `point` (on the triangle's
+    /// plane or projected onto it); `(0, 0)` where they are not numbers.
+    #[inline]
+    pub fn barycentric(&self, point: DVec3) -> (f64, f64) {
+        let [v0, v1, v2] = self.vertices;
+        let (e1, e2, d) = (v1 - v0, v2 - v0, point - v0);
+        let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+        let (d1, d2) = (d.dot(e1), d.dot(e2));
+        let det = d11 * d22 - d12 * d12;
+        let b1 = (d22 * d1 - d12 * d2) / det;
+        let b2 = (d11 * d2 - d12 * d1) / det;
+        if b1.is_finite() && b2.is_finite() {
+            (b1, b2)
+        } else {
+            (0.0, 0.0)
+        }
+    }
+
     /// Whether the triangle is shaded with vertex normals.
     pub fn has_vertex_normals(&self) -> bool {
         self.vertex_normals != NO_NORMALS

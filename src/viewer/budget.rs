@@ -230,6 +230,7 @@ mod tests {
             sides: crate::settings::Sides::Two,
             adaptive: false,
             shadows: true,
+            textures: true,
         }
     }
 

@@ -266,6 +266,20 @@ fn render_settings_ui(edit: &mut EditState, ui: &mut egui::Ui) {
                     });
             }
         });
+    if !edit.scene.textures.is_empty() {
+        let images = edit.scene.textures.len();
+        ui.checkbox(
+            &mut edit.settings.textures,
+            format!(
+                "Textures ({images} image{})",
+                if images == 1 { "" } else { "s" }
+            ),
+        )
+        .on_hover_text(
+            "draw the materials' image textures and their cut-outs; off, each textured \
+             material shows its own colour and its cut-out parts are solid, to compare",
+        );
+    }
     ui.horizontal(|ui| {
         ui.label("Frame budget while moving");
         ui.add(
@@ -439,6 +453,7 @@ fn materials_ui(edit: &mut EditState, ui: &mut egui::Ui) {
                             ui.end_row();
                         }
                     });
+                texture_maps_ui(&edit.scene, &m, ui);
             });
         if changed {
             if ka_follows_kd {
@@ -446,6 +461,33 @@ fn materials_ui(edit: &mut EditState, ui: &mut egui::Ui) {
             }
             edit.scene_mut().materials[i] = m;
         }
+    }
+}
+
+/// The textures on material `m`: each map's file as the scene names it and
+/// the image's size (read-only: a texture is changed in its file).
+fn texture_maps_ui(scene: &crate::scene::Scene, m: &crate::material::Material, ui: &mut egui::Ui) {
+    let same = m.color_map.is_some() && m.color_map == m.cutout_map;
+    for (label, map) in [
+        (
+            if same {
+                "texture (and cut-out)"
+            } else {
+                "texture"
+            },
+            &m.color_map,
+        ),
+        ("cut-out", if same { &None } else { &m.cutout_map }),
+    ] {
+        let Some(map) = map else { continue };
+        let Some(texture) = scene.textures.get(map.texture as usize) else {
+            continue;
+        };
+        ui.label(format!(
+            "{label}: {} ({}x{})",
+            map.name, texture.width, texture.height
+        ))
+        .on_hover_text(texture.path.display().to_string());
     }
 }
 

@@ -24,6 +24,7 @@ mod sequences;
 mod simd_levels;
 mod source_files;
 mod spd_protocol;
+mod textures;
 mod viewer;
 mod viewer_files;
 mod viewer_panels;

@@ -66,6 +66,12 @@ pub struct RenderArgs {
     pub accel: Option<AccelArg>,
     #[command(flatten)]
     pub octree_params: OctreeArgs,
+    /// Draw materials' image textures (OBJ/MTL `map_Kd`, `map_d`; a TOML
+    /// material's `texture`): on (the default, or the recorded choice with
+    /// --from-png) or off, each textured material in its own colour with
+    /// no cut-outs, to compare.
+    #[arg(long, value_enum)]
+    pub textures: Option<Switch>,
     /// Render threads (default: one per core; at most 8 per core).
     #[arg(long, default_value_t = 0, hide_default_value = true)]
     pub threads: usize,
@@ -291,8 +297,11 @@ fn prepare(args: &RenderArgs) -> Result<Prepared> {
         // Validate before starting.
         Renderer::with_camera(&scene, &accel, settings, &camera)
             .with_context(|| format!("cannot render {scene_name}"))?;
-        glint::render::memory::check_memory(&settings, accel.memory_bytes())
-            .with_context(|| format!("cannot render {scene_name}"))?;
+        glint::render::memory::check_memory(
+            &settings,
+            accel.memory_bytes() + scene.texture_bytes(),
+        )
+        .with_context(|| format!("cannot render {scene_name}"))?;
     }
     Ok(Prepared {
         scene,
@@ -322,6 +331,7 @@ fn overrides(args: &RenderArgs) -> Result<Overrides> {
         accel: AccelArg::resolve(args.accel, args.octree)?,
         octree: args.octree_params.overrides(),
         view: args.view,
+        textures: args.textures.map(Switch::is_on),
         ..Overrides::default()
     };
     args.rules.add_to(&mut o);

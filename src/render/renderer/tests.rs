@@ -106,7 +106,7 @@ fn shadow_hints_change_no_answer() {
                 &mut crossings,
                 &mut NoCounts,
             );
-            let expected = renderer.pass_through(&crossings);
+            let expected = renderer.pass_through(&ray.ray, &crossings);
             assert_eq!(
                 pass.to_bits(),
                 expected.to_bits(),
