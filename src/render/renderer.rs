@@ -273,7 +273,8 @@ pub struct Renderer<'a> {
     pub(super) grid: Vec<(f64, f64)>,
     is_transparent: Vec<bool>,
     /// How textures are drawn, when the scene has them and they are on.
-    pub(super) texturing: Option<Texturing>,
+    /// Boxed: its texel table would otherwise double the renderer's size.
+    pub(super) texturing: Option<Box<Texturing>>,
     /// Whether some triangle's material cuts it out: queries then look
     /// past the gaps.
     pub(super) cuts_out: bool,
@@ -326,7 +327,7 @@ impl<'a> Renderer<'a> {
         }
         let camera_spec = *camera;
         let camera = Camera::new(camera, settings.width, settings.height)?;
-        let texturing = Texturing::new(scene, &settings);
+        let texturing = Texturing::new(scene, &settings).map(Box::new);
         // Cut-out triangles let light through their gaps: shadow rays
         // record their crossings as they do a transparent surface's.
         let is_transparent: Vec<bool> = scene
@@ -656,10 +657,21 @@ impl<'a> Renderer<'a> {
     }
 
     /// The light a shadow ray's crossings let through.
+    #[inline(always)]
     pub(super) fn pass_through(&self, ray: &Ray, found: &ShadowCrossings) -> f64 {
         if found.is_blocked() {
             return 0.0;
         }
+        if self.cuts_out {
+            self.pass_through_crossings::<true>(ray, found)
+        } else {
+            self.pass_through_crossings::<false>(ray, found)
+        }
+    }
+
+    /// [`Renderer::pass_through`] of a ray not blocked, looking up the
+    /// gaps of cut-outs if `GAPS` (a render without cut-outs skips the test).
+    fn pass_through_crossings<const GAPS: bool>(&self, ray: &Ray, found: &ShadowCrossings) -> f64 {
         // Crossings come sorted by distance, so the product is the same
         // whichever order they were found in.
         let same_place = SAME_SURFACE_RELATIVE * self.floor_scale;
@@ -667,7 +679,7 @@ impl<'a> Renderer<'a> {
         let mut previous: Option<(f64, u32)> = None;
         for &(t, shape) in found.transparent() {
             // Light passes a cut-out's gaps untouched.
-            if self.cuts_out && self.crosses_gap(ray, shape, t) {
+            if GAPS && self.crosses_gap(ray, shape, t) {
                 continue;
             }
             let material = self.scene.shape_materials[shape as usize];

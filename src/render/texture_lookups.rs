@@ -12,6 +12,7 @@ use crate::shapes::{PreparedRay, Shape, ShapeHit};
 use crate::stats::Counter;
 
 use super::renderer::{Query, Renderer};
+use super::texturing::Texturing;
 
 /// How many gaps one ray passes before the surface behind the last one is
 /// taken as its hit: a bound on a ray grazing a stack of leaves, never met
@@ -21,7 +22,7 @@ const MAX_GAPS: u32 = 1024;
 impl Renderer<'_> {
     /// `color`, the diffuse colour of material `material`, times its colour
     /// map at the hit `hit` of shape `shape` where it has one.
-    #[inline]
+    #[inline(always)]
     pub(super) fn textured_color(
         &self,
         color: Color,
@@ -29,9 +30,23 @@ impl Renderer<'_> {
         shape: u32,
         hit: &ShapeHit,
     ) -> Color {
-        let Some(texturing) = &self.texturing else {
-            return color;
-        };
+        match &self.texturing {
+            None => color,
+            Some(texturing) => self.color_map_at(texturing, color, material, shape, hit),
+        }
+    }
+
+    /// [`Renderer::textured_color`] in a render with textures: apart, so
+    /// that renders without them keep their shading code as it was.
+    #[inline(never)]
+    fn color_map_at(
+        &self,
+        texturing: &Texturing,
+        color: Color,
+        material: u32,
+        shape: u32,
+        hit: &ShapeHit,
+    ) -> Color {
         let Some(map) = &self.materials[material as usize].color_map else {
             return color;
         };
@@ -73,7 +88,7 @@ impl Renderer<'_> {
     }
 
     /// Whether the shadow ray `ray` crosses shape `shape` at `t` through a gap.
-    #[inline]
+    #[inline(never)]
     pub(super) fn crosses_gap(&self, ray: &Ray, shape: u32, t: f64) -> bool {
         match &self.scene.shapes[shape as usize] {
             Shape::Triangle(triangle) => {
@@ -88,6 +103,7 @@ impl Renderer<'_> {
     /// the gaps of cut-out triangles: from just beyond each gap the query
     /// goes on in the same direction. The hit's distance is measured along
     /// `ray` from its own origin.
+    #[inline(never)]
     pub(super) fn past_gaps<C: Counter>(
         &self,
         ray: &PreparedRay,

@@ -138,7 +138,13 @@ pub(super) fn mesh_materials(
                         Channel::Color => "map_Kd",
                         Channel::Value => "map_d",
                     };
-                    match super::textures::texture_index(scene, folder, &spec.file, files) {
+                    match super::textures::texture_index(
+                        scene,
+                        folder,
+                        &spec.file,
+                        super::textures::Namer::Model,
+                        files,
+                    ) {
                         Ok(texture) => {
                             let map = TextureMap {
                                 texture,

@@ -15,16 +15,28 @@ use super::file_source::{FileSource, inside_folder};
 use super::model::Scene;
 use crate::texture::Texture;
 
+/// Where the file naming a texture comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Namer {
+    /// A model's material file, shared with the model: its textures are
+    /// looked for inside its folder only.
+    Model,
+    /// A scene file the user wrote: its paths go where they say, as its
+    /// mesh paths do.
+    Scene,
+}
+
 /// Index in `scene.textures` of the image `written` names, from a file in
 /// `folder`: read and decoded the first time any material names it.
 pub(super) fn texture_index(
     scene: &mut Scene,
     folder: &Path,
     written: &str,
+    namer: Namer,
     files: &dyn FileSource,
 ) -> Result<u32, String> {
     let mut looked_at = Vec::new();
-    for relative in candidates(written) {
+    for relative in candidates(written, namer) {
         let path = folder.join(&relative);
         if let Some(i) = scene.textures.iter().position(|t| t.path == path) {
             return Ok(i as u32);
@@ -54,10 +66,10 @@ pub(super) fn texture_index(
 /// Where `written` may be, relative to the naming file's folder, in the
 /// order tried: the path as written (if it stays inside the folder), then
 /// its file name alone.
-fn candidates(written: &str) -> Vec<PathBuf> {
+fn candidates(written: &str, namer: Namer) -> Vec<PathBuf> {
     let normalized = written.trim().replace('\\', "/");
     let mut out = Vec::new();
-    if inside_folder(Path::new(""), &normalized).is_some() {
+    if namer == Namer::Scene || inside_folder(Path::new(""), &normalized).is_some() {
         out.push(PathBuf::from(&normalized));
     }
     if let Some(name) = Path::new(&normalized).file_name() {
@@ -157,20 +169,37 @@ mod tests {
         let mut s = scene();
         let folder = Path::new("m");
         assert_eq!(
-            texture_index(&mut s, folder, "tex\\wood.png", &files),
+            texture_index(&mut s, folder, "tex\\wood.png", Namer::Model, &files),
             Ok(0)
         );
         // The same file by another spelling is decoded once.
-        assert_eq!(texture_index(&mut s, folder, "TEX/wood.png", &files), Ok(0));
         assert_eq!(
-            texture_index(&mut s, folder, "C:\\Users\\me\\Desktop\\leaf.png", &files),
+            texture_index(&mut s, folder, "TEX/wood.png", Namer::Model, &files),
+            Ok(0)
+        );
+        assert_eq!(
+            texture_index(
+                &mut s,
+                folder,
+                "C:\\Users\\me\\Desktop\\leaf.png",
+                Namer::Model,
+                &files
+            ),
             Ok(1)
         );
         assert_eq!(s.textures.len(), 2);
         assert_eq!(s.textures[0].path, Path::new("m/tex/Wood.PNG"));
-        let e = texture_index(&mut s, folder, "../outside/leaf2.png", &files).unwrap_err();
+        let e = texture_index(&mut s, folder, "../outside/leaf2.png", Namer::Model, &files)
+            .unwrap_err();
         assert!(e.contains("no such file (looked for m/leaf2.png)"), "{e}");
-        let e = texture_index(&mut s, folder, "gone.png", &files).unwrap_err();
+        // A scene file's own path goes where it says.
+        let e = texture_index(&mut s, folder, "../outside/leaf2.png", Namer::Scene, &files)
+            .unwrap_err();
+        assert!(
+            e.contains("looked for m/../outside/leaf2.png and m/leaf2.png"),
+            "{e}"
+        );
+        let e = texture_index(&mut s, folder, "gone.png", Namer::Model, &files).unwrap_err();
         assert!(e.contains("m/gone.png"), "{e}");
     }
 
@@ -180,7 +209,8 @@ mod tests {
             PathBuf::from("m/t.png"),
             b"text".to_vec(),
         )]));
-        let e = texture_index(&mut scene(), Path::new("m"), "t.png", &files).unwrap_err();
+        let e =
+            texture_index(&mut scene(), Path::new("m"), "t.png", Namer::Model, &files).unwrap_err();
         assert!(e.starts_with("m/t.png: not an image glint reads"), "{e}");
     }
 }

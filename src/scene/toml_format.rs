@@ -194,7 +194,8 @@ impl Context<'_> {
             return Ok(());
         };
         let folder = self.path.parent().unwrap_or(Path::new(""));
-        let texture = super::textures::texture_index(scene, folder, name.get_ref(), files)
+        let namer = super::textures::Namer::Scene;
+        let texture = super::textures::texture_index(scene, folder, name.get_ref(), namer, files)
             .map_err(|e| self.error(name.span(), &format!("{prefix}.texture"), e))?;
         let map = crate::texture::TextureMap::new(texture, name.get_ref().clone());
         let material = &mut scene.materials[index];

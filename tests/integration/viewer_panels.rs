@@ -280,3 +280,37 @@ fn ray_sample_lines(h: &egui_kittest::Harness<'static, GlintApp>) -> usize {
     })
     .count()
 }
+
+/// A textured scene's render settings have a Textures box: unticked, the
+/// scene renders again with each material in its own colour. The
+/// materials panel names each material's image and its size.
+#[test]
+fn the_textures_box_switches_textures_and_materials_name_their_images() {
+    let mut h = harness(app_for("scenes/garden.toml", 64, 48));
+    settle(&mut h);
+    assert!(h.state().settings().textures);
+    let generation = h.state().worker().generation();
+    h.get_by_label("Textures (3 images)").click();
+    h.run_steps(3);
+    assert!(!h.state().settings().textures);
+    assert!(
+        h.state().worker().generation() > generation,
+        "renders again without textures"
+    );
+    // The open sections closed, so the materials fit the panel.
+    for section in [
+        "Render settings",
+        "Inspect and compare",
+        "Camera",
+        "Camera path",
+        "Lights",
+    ] {
+        h.get_by_label(section).click();
+        h.run_steps(1);
+    }
+    h.get_by_label("Materials").click();
+    h.run_steps(2);
+    h.get_by_label("fence").click();
+    h.run_steps(2);
+    h.get_by_label_contains("texture (and cut-out): fence.png (256x128)");
+}
