@@ -143,3 +143,21 @@ def test_octree_statistics_are_the_ones_bench_reports():
     for key in ("traversal_steps_per_ray", "intersection_tests_per_ray"):
         assert built["predicted"][key] == bench["predicted"][key]
     assert json.dumps(built)  # plain data, as JSON
+
+
+def test_textures_on_and_off_are_the_cli_pngs(tmp_path, glint_cli):
+    """``textures=False`` is ``--textures off``: the same PNG bytes, and
+    pixels that differ from the textured render's (the garden's floor,
+    fence and leaves lose their images and cut-outs)."""
+    path = scene_path("garden.toml")
+    scene = glint.load(path)
+    frames = {}
+    for textures, flag in [(True, "on"), (False, "off")]:
+        frame = scene.render(64, 48, aa="off", textures=textures)
+        frame.save(tmp_path / "python.png")
+        glint_cli("render", path, "--width", 64, "--height", 48, "--aa", "off",
+                  "--textures", flag, "-o", tmp_path / "cli.png", "-q")
+        assert (tmp_path / "python.png").read_bytes() == (tmp_path / "cli.png").read_bytes()
+        frames[textures] = frame.srgb8()
+    differing = np.any(frames[True] != frames[False], axis=2).mean()
+    assert differing > 0.3, differing
