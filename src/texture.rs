@@ -129,6 +129,9 @@ impl Texture {
     /// or for TGA, which has no signature, from `path`'s extension).
     pub fn decode(path: &Path, bytes: &[u8]) -> Result<Self, String> {
         use image::ImageFormat;
+        if bytes.is_empty() {
+            return Err("the file is empty".into());
+        }
         // TGA alone has no signature: only its extension names it.
         let tga = ImageFormat::from_path(path).ok() == Some(ImageFormat::Tga);
         let format = image::guess_format(bytes)

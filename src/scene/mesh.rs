@@ -48,6 +48,8 @@ pub struct LoadedMesh {
     pub uvs: Vec<Option<[[f64; 2]; 3]>>,
     /// Elements glint does not render, counted.
     pub skipped: SkippedElements,
+    /// The file's header comment, where exporters name themselves.
+    pub header: Option<String>,
 }
 
 /// Parses OBJ bytes (every refusal names its line). `smooth`: `None` uses
@@ -217,6 +219,7 @@ pub fn parse_obj(
         colors: triangle_colors,
         uvs: triangle_uvs,
         skipped,
+        header: data.header,
     })
 }
 

@@ -25,6 +25,8 @@ pub(super) fn read_libraries(
     let folder = obj_path.parent().unwrap_or(Path::new(""));
     let mut entries = Vec::new();
     for written in libraries {
+        // Written on Windows: `\` (or a doubled `\\`) separates folders.
+        let written = &written.replace('\\', "/");
         // One file name with spaces, or several names.
         let whole = inside_folder(folder, written);
         let names: Vec<(&str, Option<std::path::PathBuf>)> =
@@ -102,8 +104,13 @@ pub(super) fn mesh_materials(
     let mut grouped: std::collections::BTreeMap<String, Vec<String>> = Default::default();
     // Textures that could not be read, said once each with the materials
     // that name them.
-    let mut unread_textures: std::collections::BTreeMap<String, Vec<String>> = Default::default();
+    #[allow(clippy::type_complexity)]
+    let mut unread_textures: std::collections::BTreeMap<
+        (String, String),
+        (String, Vec<String>),
+    > = Default::default();
     let mut textured_without_uvs = Vec::new();
+    let mut tr_alone: Vec<(String, String)> = Vec::new();
     let used: Vec<bool> = {
         let mut used = vec![false; mesh.material_names.len()];
         for &m in &mesh.triangle_materials {
@@ -117,8 +124,11 @@ pub(super) fn mesh_materials(
             .flatten();
         let index = match entry {
             Some(e) if used[slot] => {
-                if let (_, Some(note)) = e.opacity() {
-                    scene.load_notes.push(note);
+                match e.opacity() {
+                    // MeshLab's habit, often on every material: said once.
+                    (_, Some(note)) if e.d.is_none() => tr_alone.push((e.name.clone(), note)),
+                    (_, Some(note)) => scene.load_notes.push(note),
+                    _ => {}
                 }
                 let clamped = e.clamped();
                 if !clamped.is_empty() {
@@ -169,12 +179,12 @@ pub(super) fn mesh_materials(
                             }
                         }
                         Err(reason) => unread_textures
-                            .entry(format!(
-                                "{}: texture `{}` ({keyword}) cannot be read: {reason}",
-                                e.library.display(),
-                                spec.file
+                            .entry((
+                                e.library.display().to_string(),
+                                format!("`{}` ({keyword})", spec.file),
                             ))
-                            .or_default()
+                            .or_insert_with(|| (reason, Vec::new()))
+                            .1
                             .push(e.name.clone()),
                     }
                 }
@@ -215,22 +225,66 @@ pub(super) fn mesh_materials(
         };
         slots.push(index);
     }
-    for (note, names) in unread_textures {
-        let named = names
-            .iter()
-            .map(|n| format!("`{n}`"))
-            .collect::<Vec<_>>()
-            .join(", ");
-        scene.load_notes.push(format!(
-            "{note}; {} {named} {} drawn in {} own `Kd` colour",
-            if names.len() == 1 {
-                "material"
-            } else {
-                "materials"
-            },
-            if names.len() == 1 { "is" } else { "are" },
-            if names.len() == 1 { "its" } else { "their" },
-        ));
+    // Textures not found: one note per library. Those found but not
+    // decoded: one note each, with the reason.
+    let drawn_plain = |names: &[String]| {
+        let one = names.len() == 1;
+        format!(
+            "{} {} {} drawn in {} own `Kd` colour",
+            if one { "material" } else { "materials" },
+            listed(names),
+            if one { "is" } else { "are" },
+            if one { "its" } else { "their" },
+        )
+    };
+    let mut missing: std::collections::BTreeMap<String, Vec<(String, String, Vec<String>)>> =
+        Default::default();
+    for ((library, texture), (reason, names)) in unread_textures {
+        if reason.starts_with("no such file") {
+            missing
+                .entry(library)
+                .or_default()
+                .push((texture, reason, names));
+        } else {
+            scene.load_notes.push(format!(
+                "{library}: texture {texture} cannot be read: {reason}; {}",
+                drawn_plain(&names)
+            ));
+        }
+    }
+    for (library, textures) in missing {
+        scene.load_notes.push(match textures.as_slice() {
+            [(texture, reason, names)] => format!(
+                "{library}: texture {texture} cannot be read: {reason}; {}",
+                drawn_plain(names)
+            ),
+            _ => {
+                let files: Vec<String> = textures.iter().map(|(t, ..)| t.clone()).collect();
+                let mut names: Vec<String> = textures.into_iter().flat_map(|(.., n)| n).collect();
+                names.sort();
+                names.dedup();
+                format!(
+                    "{library}: {} textures it names are in neither its folder nor a \
+                     `textures` folder beside it ({}); {}",
+                    files.len(),
+                    files.join(", "),
+                    drawn_plain(&names)
+                )
+            }
+        });
+    }
+    match tr_alone.as_slice() {
+        [] => {}
+        // One: where it is written.
+        [(_, note)] => scene.load_notes.push(note.clone()),
+        _ => grouped
+            .entry(
+                "with `Tr 1` alone, which would make them invisible: read as opaque, as \
+                 MeshLab and other exporters mean it"
+                    .into(),
+            )
+            .or_default()
+            .extend(tr_alone.into_iter().map(|(name, _)| name)),
     }
     if !textured_without_uvs.is_empty() {
         grouped
@@ -241,17 +295,23 @@ pub(super) fn mesh_materials(
             .extend(textured_without_uvs);
     }
     for (note, names) in grouped {
-        let named = names
-            .iter()
-            .map(|n| format!("`{n}`"))
-            .collect::<Vec<_>>()
-            .join(", ");
+        let named = listed(&names);
         scene.load_notes.push(match names.len() {
             1 => format!("{}: material {named} {note}", mesh_path.display()),
             n => format!("{}: {n} materials ({named}) {note}", mesh_path.display()),
         });
     }
     (slots, default)
+}
+
+/// Names in backquotes, the first six of them and how many more.
+fn listed(names: &[String]) -> String {
+    const SHOWN: usize = 6;
+    let mut out: Vec<String> = names.iter().take(SHOWN).map(|n| format!("`{n}`")).collect();
+    if names.len() > SHOWN {
+        out.push(format!("and {} more", names.len() - SHOWN));
+    }
+    out.join(", ")
 }
 
 /// Each scene material `mesh_materials` gave `mesh`, once, with the name a

@@ -126,6 +126,9 @@ pub struct MeshCounts {
     pub folded_quads: usize,
     pub dropped_polygons: DroppedPolygons,
     pub skipped_elements: SkippedElements,
+    /// The header comment the file opens with (the exporter, usually).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub header: Option<String>,
 }
 
 /// A material a mesh object of a TOML scene took from its own file.

@@ -59,6 +59,9 @@ pub(super) struct ObjData {
     pub materials: Vec<String>,
     /// `mtllib` arguments, as written.
     pub libraries: Vec<String>,
+    /// The first comment before any statement that has words in it: where
+    /// exporters name themselves (`# Blender v2.79 (sub 0) OBJ File: ''`).
+    pub header: Option<String>,
     pub skipped: SkippedElements,
 }
 
@@ -159,19 +162,31 @@ pub(super) fn parse(bytes: &[u8]) -> Result<ObjData, ObjError> {
     // first); they are checked once every vertex is known.
     let mut last_line_of_face: Vec<usize> = Vec::new();
     let text = super::text::utf8_text(bytes);
+    let mut in_header = true;
     for (number, line) in logical_lines(&text) {
         let err = |message: String| ObjError {
             line: number,
             message,
         };
-        let content = match super::text::comment_start(&line).map_err(&err)? {
+        let hash = super::text::comment_start(&line).map_err(&err)?;
+        let content = match hash {
             Some(hash) => &line[..hash],
             None => &line[..],
         };
         let content = content.trim_ascii();
         if content.is_empty() {
+            if let Some(hash) = hash
+                && in_header
+                && data.header.is_none()
+            {
+                let comment = String::from_utf8_lossy(line[hash + 1..].trim_ascii());
+                if comment.chars().any(|c| c.is_alphabetic()) {
+                    data.header = Some(comment.chars().take(120).collect());
+                }
+            }
             continue;
         }
+        in_header = false;
         let keyword_len = content.iter().position(is_space).unwrap_or(content.len());
         let keyword = &content[..keyword_len];
         let mut args = content[keyword_len..]

@@ -65,17 +65,20 @@ pub(super) fn texture_index(
 
 /// Where `written` may be, relative to the naming file's folder, in the
 /// order tried: the path as written (if it stays inside the folder), then
-/// its file name alone.
+/// its file name alone, then that name in a `textures` folder.
 fn candidates(written: &str, namer: Namer) -> Vec<PathBuf> {
     let normalized = written.trim().replace('\\', "/");
     let mut out = Vec::new();
     if namer == Namer::Scene || inside_folder(Path::new(""), &normalized).is_some() {
         out.push(PathBuf::from(&normalized));
     }
+    // Then the file name alone, beside the naming file and in a
+    // `textures` folder there (where exporters and asset packs put them).
     if let Some(name) = Path::new(&normalized).file_name() {
-        let p = PathBuf::from(name);
-        if !out.contains(&p) {
-            out.push(p);
+        for p in [PathBuf::from(name), Path::new("textures").join(name)] {
+            if !out.contains(&p) {
+                out.push(p);
+            }
         }
     }
     out
@@ -191,7 +194,10 @@ mod tests {
         assert_eq!(s.textures[0].path, Path::new("m/tex/Wood.PNG"));
         let e = texture_index(&mut s, folder, "../outside/leaf2.png", Namer::Model, &files)
             .unwrap_err();
-        assert!(e.contains("no such file (looked for m/leaf2.png)"), "{e}");
+        assert!(
+            e.contains("no such file (looked for m/leaf2.png and m/textures/leaf2.png)"),
+            "{e}"
+        );
         // A scene file's own path goes where it says.
         let e = texture_index(&mut s, folder, "../outside/leaf2.png", Namer::Scene, &files)
             .unwrap_err();

@@ -623,6 +623,7 @@ fn add_object(
                 folded_quads: mesh.folded_quads,
                 dropped_polygons: mesh.dropped_polygons,
                 skipped_elements: mesh.skipped.clone(),
+                header: mesh.header.clone(),
             });
             if mesh.folded_quads > 0 {
                 scene.load_notes.push(format!(

@@ -117,7 +117,7 @@ fn shared_material_notes_are_grouped_and_ghosts_named() {
     write(
         dir.path(),
         "many.mtl",
-        b"newmtl a\nNs -1.96\nnewmtl b\nNs -1.96\nnewmtl c\nNs -1.96\n\
+        b"newmtl a\nNs -1.96\nTr 1\nnewmtl b\nNs -1.96\nTr 1\nnewmtl c\nNs -1.96\nTr 1\n\
           newmtl ghost\nKd 0.5 0.5 0.5\nd 0\n\
           newmtl glass\nillum 7\nd 0\nNi 1.5\n",
     );
@@ -130,6 +130,10 @@ fn shared_material_notes_are_grouped_and_ghosts_named() {
         highlight[0].contains("3 materials (`a`, `b`, `c`)"),
         "{notes:?}"
     );
+    // MeshLab's `Tr 1` on every material: one note, not one a material.
+    let tr: Vec<_> = notes.iter().filter(|n| n.contains("`Tr 1` alone")).collect();
+    assert_eq!(tr.len(), 1, "{notes:?}");
+    assert!(tr[0].contains("3 materials (`a`, `b`, `c`)"), "{notes:?}");
     let ghosts: Vec<_> = notes
         .iter()
         .filter(|n| n.contains("fully transparent"))

@@ -280,6 +280,29 @@ fn textures_are_shared_and_a_missing_one_is_a_note() {
         "{notes}"
     );
     assert!(scene.textures.is_empty());
+    // Several missing textures of one library: one note naming them all;
+    // a texture kept in a `Textures` folder beside the MTL is found.
+    std::fs::create_dir(dir.path().join("Textures")).unwrap();
+    write(&dir.path().join("Textures"), "t.png", &png(1, 1, &[GREEN]));
+    write(
+        dir.path(),
+        "quad.mtl",
+        b"newmtl skin\nmap_Kd a.png\nmap_d b.png\nnewmtl other\nmap_Kd c.png\n",
+    );
+    let notes = load_file(&toml).notes();
+    let about: Vec<&String> = notes.iter().filter(|n| n.contains("textures it names")).collect();
+    assert_eq!(about.len(), 1, "{notes:?}");
+    assert!(
+        about[0].contains("3 textures it names are in neither its folder nor a `textures` folder")
+            && about[0].contains("`b.png` (map_d)"),
+        "{}",
+        about[0]
+    );
+    write(dir.path(), "quad.mtl", b"newmtl skin\nmap_Kd t.png\n");
+    std::fs::remove_file(dir.path().join("t.png")).unwrap();
+    let scene = load_file(&toml);
+    assert_eq!(scene.textures.len(), 1, "{:?}", scene.notes());
+    assert!(scene.textures[0].path.ends_with("Textures/t.png"));
 }
 
 /// A TOML material names a texture and a TOML triangle its coordinates;
