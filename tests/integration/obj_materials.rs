@@ -131,7 +131,10 @@ fn shared_material_notes_are_grouped_and_ghosts_named() {
         "{notes:?}"
     );
     // MeshLab's `Tr 1` on every material: one note, not one a material.
-    let tr: Vec<_> = notes.iter().filter(|n| n.contains("`Tr 1` alone")).collect();
+    let tr: Vec<_> = notes
+        .iter()
+        .filter(|n| n.contains("`Tr 1` alone"))
+        .collect();
     assert_eq!(tr.len(), 1, "{notes:?}");
     assert!(tr[0].contains("3 materials (`a`, `b`, `c`)"), "{notes:?}");
     let ghosts: Vec<_> = notes

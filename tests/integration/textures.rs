@@ -290,7 +290,10 @@ fn textures_are_shared_and_a_missing_one_is_a_note() {
         b"newmtl skin\nmap_Kd a.png\nmap_d b.png\nnewmtl other\nmap_Kd c.png\n",
     );
     let notes = load_file(&toml).notes();
-    let about: Vec<&String> = notes.iter().filter(|n| n.contains("textures it names")).collect();
+    let about: Vec<&String> = notes
+        .iter()
+        .filter(|n| n.contains("textures it names"))
+        .collect();
     assert_eq!(about.len(), 1, "{notes:?}");
     assert!(
         about[0].contains("3 textures it names are in neither its folder nor a `textures` folder")
