@@ -1,5 +1,6 @@
-//! Textures looked up at hits: a colour map's colour, and cut-outs, the gaps a map's alpha below one half makes, which eye rays
-//! and shadow rays pass through.
+//! Textures looked up at hits: a colour map's colour, and cut-outs, the
+//! gaps a map's alpha below one half makes, which eye rays and shadow rays
+//! pass through.
 //!
 //! Only triangles carry texture coordinates, so only they are textured or
 //! cut. A ray that meets a gap goes on from just past it in the same
