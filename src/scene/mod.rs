@@ -5,10 +5,13 @@
 pub mod builtin;
 pub mod edit;
 mod file_source;
+mod interior_view;
 mod keyhole;
 mod mesh;
 mod mesh_materials;
 mod model;
+mod model_axes;
+mod model_probe;
 mod mtl;
 pub mod nff;
 mod obj;

@@ -5,14 +5,15 @@
 
 use std::path::Path;
 
-use crate::accel::{Octree, OctreeParams, Primitives, WalkStack};
+use crate::accel::WalkStack;
 use crate::camera::{Camera, CameraSpec};
 use crate::math::{Aabb, DVec3};
-use crate::shapes::{PreparedRay, Shape};
-use crate::stats::NoCounts;
 
 use super::file_source::FileSource;
+use super::interior_view::interior_view;
 use super::model::{Scene, SceneError};
+use super::model_axes::{ModelAxes, model_axes};
+use super::model_probe::ModelProbe;
 use super::toml_format;
 
 /// Vertical field of view of the framing camera, degrees.
@@ -84,11 +85,7 @@ pub(super) fn load(path: &Path, files: &dyn FileSource) -> Result<Scene, SceneEr
     })?;
     let bounds = scene.geometry_bounds();
     let header = scene.meshes.first().and_then(|m| m.header.as_deref());
-    let axes = if header.is_some_and(exporter_writes_y_up) {
-        Y_UP
-    } else {
-        model_axes(&scene.shapes, bounds)
-    };
+    let axes = model_axes(&scene.shapes, bounds, header);
     // A model with no faces (only lines or points): the unit box.
     let bounds = if bounds.is_empty() {
         Aabb::new(DVec3::splat(-1.0), DVec3::splat(1.0))
@@ -103,17 +100,27 @@ pub(super) fn load(path: &Path, files: &dyn FileSource) -> Result<Scene, SceneEr
     };
     let direction = view_direction(bounds.max - bounds.min, axes);
     let (mut camera, mut light) = frame(bounds, axes, direction).ok_or_else(too_large)?;
-    // The same view from the opposite side, when it shows clearly more of
-    // the model: its features rather than a flat back, the inside of a box
-    // open on that side, a face rather than the back of a head.
-    let mirrored = direction
-        - 2.0 * direction.dot(axes.front.abs()) * axes.front.abs()
-        - 2.0 * direction.dot(axes.side.abs()) * axes.side.abs();
-    if let Some((other_camera, other_light)) = frame(bounds, axes, mirrored)
-        && let Some(seen) = StructureSeen::new(&scene.shapes, &scene.vertex_normals)
-        && seen.of(&other_camera) > seen.of(&camera) * 5 / 4 + 1
-    {
-        (camera, light) = (other_camera, other_light);
+    let probe = ModelProbe::new(&scene.shapes, &scene.vertex_normals);
+    if let Some(probe) = &probe {
+        if let Some(inside) = interior_view(probe, bounds, axes.up, [axes.side, axes.front])
+            && shows_more(probe, &inside.0, &camera)
+        {
+            // An enclosed model: its shell hides what it was made for.
+            (camera, light) = inside;
+        } else {
+            // The same view from the opposite side, when it shows clearly
+            // more of the model: its features rather than a flat back, the
+            // inside of a box open on that side, a face rather than the
+            // back of a head.
+            let mirrored = direction
+                - 2.0 * direction.dot(axes.front.abs()) * axes.front.abs()
+                - 2.0 * direction.dot(axes.side.abs()) * axes.side.abs();
+            if let Some((other_camera, other_light)) = frame(bounds, axes, mirrored)
+                && shows_more(probe, &other_camera, &camera)
+            {
+                (camera, light) = (other_camera, other_light);
+            }
+        }
     }
     let text = wrapper_text(path, &camera, light);
     scene.camera = camera;
@@ -122,97 +129,6 @@ pub(super) fn load(path: &Path, files: &dyn FileSource) -> Result<Scene, SceneEr
     }
     scene.source_text = std::sync::Arc::from(text.as_str());
     Ok(scene)
-}
-
-/// The model's own axes: which way is up, which side is its front, and
-/// the one across. OBJ has no up axis of its own; exporters mostly write
-/// +y up with the model facing +z (Blender's and 3ds Max's defaults), but
-/// scans and CAD or 3D-printing exports are +z up, facing -y (Blender's
-/// front view looks along +y).
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct ModelAxes {
-    side: DVec3,
-    up: DVec3,
-    front: DVec3,
-}
-
-const Y_UP: ModelAxes = ModelAxes {
-    side: DVec3::X,
-    up: DVec3::Y,
-    front: DVec3::Z,
-};
-const Z_UP: ModelAxes = ModelAxes {
-    side: DVec3::X,
-    up: DVec3::Z,
-    front: DVec3::NEG_Y,
-};
-
-/// Whether the exporter a header comment names writes +y up by default:
-/// Blender's OBJ exporter (up Y, forward -Z unless changed), 3ds Max's
-/// (guruware's, which flips to y-up), Maya, Cinema 4D and Wings 3D, whose
-/// own axes are y-up. Their files are read y-up whatever their content
-/// suggests (a fence's flat back is no base).
-fn exporter_writes_y_up(header: &str) -> bool {
-    let header = header.to_ascii_lowercase();
-    [
-        "blender",
-        "guruware",
-        "3ds max wavefront obj exporter",
-        "maya",
-        "cinema 4d",
-        "wings 3d",
-    ]
-    .iter()
-    .any(|name| header.contains(name))
-}
-
-/// The up axis the model's content suggests: +z when the model stands on
-/// a flat base at its lowest z (faces perpendicular to z there covering at
-/// least 2 % of its footprint) that has no match at its top (a box or a
-/// slab is flat at both ends and says nothing) and no comparable base at
-/// its lowest y; +y, OBJ's convention, otherwise. A statue's plinth, a
-/// 3D-print's bed face or a building's ground slab is such a base; the
-/// flat butt of a rifle lying along z is not, its muzzle end being as flat.
-fn model_axes(shapes: &[Shape], bounds: Aabb) -> ModelAxes {
-    let extent = bounds.max - bounds.min;
-    // Area of faces perpendicular to `axis` lying at its low and high end,
-    // as fractions of the model's footprint across that axis.
-    let flat_ends = |axis: usize| {
-        let across = extent[(axis + 1) % 3] * extent[(axis + 2) % 3];
-        let tolerance = 0.01 * extent[axis];
-        let (mut low, mut high) = (0.0, 0.0);
-        if !(across > 0.0 && across.is_finite()) {
-            return (0.0, 0.0);
-        }
-        for shape in shapes {
-            let Shape::Triangle(t) = shape else { continue };
-            let [a, b, c] = t.vertices;
-            let normal = (b - a).cross(c - a);
-            let area = 0.5 * normal.length();
-            if !(area.is_finite() && normal[axis].abs() > 0.99 * 2.0 * area) {
-                continue;
-            }
-            let (lo, hi) = (
-                a[axis].min(b[axis]).min(c[axis]),
-                a[axis].max(b[axis]).max(c[axis]),
-            );
-            // A flat model's faces lie at both ends: no base.
-            if hi <= bounds.min[axis] + tolerance {
-                low += area;
-            }
-            if lo >= bounds.max[axis] - tolerance {
-                high += area;
-            }
-        }
-        (low / across, high / across)
-    };
-    let (base_z, top_z) = flat_ends(2);
-    let (base_y, _) = flat_ends(1);
-    if base_z >= 0.02 && base_z > 2.0 * top_z && base_z > 2.0 * base_y {
-        Z_UP
-    } else {
-        Y_UP
-    }
 }
 
 /// A camera that frames `bounds` and a light over its shoulder, seen from
@@ -279,80 +195,36 @@ fn view_direction(extent: DVec3, axes: ModelAxes) -> DVec3 {
     direction.normalize()
 }
 
+/// Whether view `a` shows clearly more of the model's structure than
+/// view `b` (`structure_seen`): a quarter more, and two directions at least.
+fn shows_more(probe: &ModelProbe, a: &CameraSpec, b: &CameraSpec) -> bool {
+    structure_seen(probe, a) > structure_seen(probe, b) * 5 / 4 + 1
+}
+
 /// How much of a model's structure a view shows: the number of distinct
 /// directions (to a fifth of a radian or so) the surfaces seen in a 32x32
 /// thumbnail face. A flat face, the closed back of a box or the back of a
-/// head shows few; a model's features, the inside of a box, many. The
-/// thumbnail's rays take a shallow octree of their own (no deeper than 6
-/// levels, a fraction of the render's build).
-struct StructureSeen<'a> {
-    shapes: &'a [Shape],
-    vertex_normals: &'a [[DVec3; 3]],
-    octree: Octree,
-}
-
-impl<'a> StructureSeen<'a> {
+/// head shows few; a model's features, the inside of a box, many.
+fn structure_seen(probe: &ModelProbe, camera: &CameraSpec) -> u32 {
     const SIDE: u32 = 32;
-    /// Models with more shapes than this keep the conventional side: the
-    /// thumbnails' octree would cost a noticeable part of the load.
-    const MAX_SHAPES: usize = 200_000;
-
-    fn new(shapes: &'a [Shape], vertex_normals: &'a [[DVec3; 3]]) -> Option<Self> {
-        if shapes.len() > Self::MAX_SHAPES {
-            return None;
+    let Ok(camera) = Camera::new(camera, SIDE, SIDE) else {
+        return 0;
+    };
+    let mut stack = WalkStack::default();
+    // 5 steps per component: 125 bins of directions.
+    let mut seen = [false; 125];
+    for j in 0..SIDE {
+        for i in 0..SIDE {
+            let ray = camera.ray(i, j, 0.5, 0.5);
+            let Some(hit) = probe.closest(ray, f64::INFINITY, &mut stack) else {
+                continue;
+            };
+            let bin = |x: f64| ((x + 1.0) * 2.0).round().clamp(0.0, 4.0) as usize;
+            let facing = hit.facing;
+            seen[bin(facing.x) + 5 * bin(facing.y) + 25 * bin(facing.z)] = true;
         }
-        let params = OctreeParams {
-            max_depth: 6,
-            ..OctreeParams::default()
-        };
-        let octree = Octree::build(shapes, params).ok()?;
-        Some(Self {
-            shapes,
-            vertex_normals,
-            octree,
-        })
     }
-
-    /// The distinct facing directions seen from `camera`.
-    fn of(&self, camera: &CameraSpec) -> u32 {
-        let Ok(camera) = Camera::new(camera, Self::SIDE, Self::SIDE) else {
-            return 0;
-        };
-        let prims = Primitives::opaque(self.shapes);
-        let mut stack = WalkStack::default();
-        // 5 steps per component: 125 bins of directions.
-        let mut seen = [false; 125];
-        for j in 0..Self::SIDE {
-            for i in 0..Self::SIDE {
-                let ray = camera.ray(i, j, 0.5, 0.5);
-                let prepared = PreparedRay::new(ray);
-                let Some(hit) = self.octree.closest(
-                    &prims,
-                    &prepared,
-                    f64::INFINITY,
-                    &mut stack,
-                    &mut NoCounts,
-                ) else {
-                    continue;
-                };
-                let shape = &self.shapes[hit.shape as usize];
-                let normal = shape
-                    .surface(&ray, &hit.hit, self.vertex_normals)
-                    .geometric_normal;
-                let facing = if normal.dot(ray.dir) < 0.0 {
-                    normal
-                } else {
-                    -normal
-                };
-                if !facing.is_finite() {
-                    continue;
-                }
-                let bin = |x: f64| ((x + 1.0) * 2.0).round().clamp(0.0, 4.0) as usize;
-                seen[bin(facing.x) + 5 * bin(facing.y) + 25 * bin(facing.z)] = true;
-            }
-        }
-        seen.iter().filter(|&&s| s).count() as u32
-    }
+    seen.iter().filter(|&&s| s).count() as u32
 }
 
 /// Parses `text`, the TOML an OBJ file `path` was opened with (an
@@ -363,6 +235,7 @@ pub(super) fn reload(text: &str, path: &Path, files: &dyn FileSource) -> Result<
 
 #[cfg(test)]
 mod tests {
+    use super::super::model_axes::Y_UP;
     use super::*;
 
     struct Files;
@@ -598,8 +471,9 @@ mod tests {
     #[test]
     fn the_camera_takes_the_side_that_shows_more_of_the_model() {
         let size = DVec3::new(2.0, 1.5, 1.0);
+        // Its faces wound to face out.
         let pyramid = "v 1 0 0.2\nv 1.4 0 0.5\nv 1 0 0.8\nv 0.6 0 0.5\nv 1 1 0.5\n\
-                       f 1 2 5\nf 2 3 5\nf 3 4 5\nf 4 1 5\n";
+                       f 5 2 1\nf 5 3 2\nf 5 4 3\nf 5 1 4\n";
         let room = |omit: &[&str]| framed(with(box_obj(DVec3::ZERO, size, omit), pyramid));
         let open_back = room(&["-z"]);
         assert!(open_back.eye.z < open_back.lookat.z, "{open_back:?}");
@@ -609,5 +483,186 @@ mod tests {
         assert!(closed.eye.z > closed.lookat.z, "{closed:?}");
         // The up axis stays the model's either way.
         assert_eq!(open_back.up, DVec3::Y);
+    }
+
+    /// `text`'s faces turned the other way (their vertex order reversed):
+    /// a box's faces then face its inside.
+    fn turned_inwards(text: String) -> String {
+        text.lines()
+            .map(|l| match l.strip_prefix("f ") {
+                Some(face) => {
+                    let mut ids: Vec<&str> = face.split_whitespace().collect();
+                    ids.reverse();
+                    format!("f {}\n", ids.join(" "))
+                }
+                None => format!("{l}\n"),
+            })
+            .collect()
+    }
+
+    /// A hall 20 long (x), 8 high (y) and 12 deep (z) with walls, floor
+    /// and roof half a unit thick (an outer box facing out, an inner one
+    /// facing in) and two pillars inside.
+    fn hall() -> String {
+        let mut model = box_obj(DVec3::ZERO, DVec3::new(20.0, 8.0, 12.0), &[]);
+        model = with(
+            model,
+            &turned_inwards(box_obj(DVec3::splat(0.5), DVec3::new(19.5, 7.5, 11.5), &[])),
+        );
+        for x in [7.0, 13.0] {
+            model = with(
+                model,
+                &box_obj(DVec3::new(x, 0.5, 5.5), DVec3::new(x + 1.0, 7.5, 6.5), &[]),
+            );
+        }
+        model
+    }
+
+    /// Whether `p` is inside the hall's inner box.
+    fn in_hall(p: DVec3) -> bool {
+        p.cmpgt(DVec3::splat(0.5)).all() && p.cmplt(DVec3::new(19.5, 7.5, 11.5)).all()
+    }
+
+    /// Issue 65 point 2: an enclosed hall is seen from inside, standing on
+    /// its floor at eye height, looking along its length with a wider
+    /// view, the light inside too.
+    #[test]
+    fn an_enclosed_hall_is_seen_from_inside() {
+        struct One(String);
+        impl FileSource for One {
+            fn read(&self, _: &Path) -> std::io::Result<Vec<u8>> {
+                Ok(self.0.clone().into_bytes())
+            }
+        }
+        let path = Path::new("hall.obj");
+        let scene = load(path, &One(hall())).unwrap();
+        let camera = scene.camera;
+        assert_eq!(camera.up, DVec3::Y);
+        assert_eq!(camera.fov, 60.0);
+        let eye = camera.eye;
+        assert!(in_hall(eye), "eye {eye}");
+        // Eye height: between a fifth and a half of the room's height
+        // over its floor (at 0.5), never below it.
+        assert!(eye.y > 0.5 + 0.2 * 7.0 && eye.y < 0.5 + 0.5 * 7.0, "{eye}");
+        let look = (camera.lookat - eye).normalize();
+        assert!(look.x.abs() > 0.99, "looks along the length: {look}");
+        // From most of the way back along the length, to the far end.
+        assert!(
+            (look.x < 0.0 && eye.x > 14.0) || (look.x > 0.0 && eye.x < 6.0),
+            "{eye} {look}"
+        );
+        assert!(in_hall(scene.lights[0].position));
+        // Written so: the scene text loads the same camera and light.
+        let again = reload(&scene.source_text, path, &One(hall())).unwrap();
+        assert_eq!(again.camera, scene.camera);
+        assert_eq!(again.lights, scene.lights);
+    }
+
+    /// The same hall with z up (a CAD or scan habit): inside it, standing
+    /// on the floor along z.
+    #[test]
+    fn an_enclosed_hall_with_z_up_is_seen_from_inside() {
+        // (x, y, z) becomes (x, -z, y): winding is kept by a rotation.
+        let z_up: String = hall()
+            .lines()
+            .map(|l| match l.strip_prefix("v ") {
+                Some(v) => {
+                    let c: Vec<f64> = v.split_whitespace().map(|x| x.parse().unwrap()).collect();
+                    format!("v {} {} {}\n", c[0], -c[2], c[1])
+                }
+                None => format!("{l}\n"),
+            })
+            .collect();
+        struct One(String);
+        impl FileSource for One {
+            fn read(&self, _: &Path) -> std::io::Result<Vec<u8>> {
+                Ok(self.0.clone().into_bytes())
+            }
+        }
+        let scene = load(Path::new("hall.obj"), &One(z_up)).unwrap();
+        let probe = ModelProbe::new(&scene.shapes, &scene.vertex_normals).unwrap();
+        let (camera, light) = interior_view(
+            &probe,
+            scene.geometry_bounds(),
+            DVec3::Z,
+            [DVec3::X, DVec3::NEG_Y],
+        )
+        .unwrap();
+        let back = |v: DVec3| DVec3::new(v.x, v.z, -v.y);
+        assert_eq!(camera.up, DVec3::Z);
+        let eye = back(camera.eye);
+        assert!(in_hall(eye), "eye {eye}");
+        assert!(eye.y > 0.5 + 0.2 * 7.0 && eye.y < 0.5 + 0.5 * 7.0, "{eye}");
+        assert!((back(camera.lookat) - eye).normalize().x.abs() > 0.99);
+        assert!(in_hall(back(light)));
+    }
+
+    /// A room of single walls facing in (a room modelled to be seen from
+    /// inside, as the conference room is) is seen from inside; the same
+    /// box facing out is an object (`the_camera_takes_the_side_...`), and
+    /// a room open at its front is seen through that side.
+    #[test]
+    fn a_room_facing_in_is_seen_from_inside_and_an_open_one_from_outside() {
+        let size = DVec3::new(10.0, 4.0, 6.0);
+        let table = box_obj(DVec3::new(4.0, 0.0, 2.5), DVec3::new(6.0, 1.0, 3.5), &[]);
+        let room = turned_inwards(box_obj(DVec3::ZERO, size, &[]));
+        let camera = framed(with(room.clone(), &table));
+        let eye = camera.eye;
+        assert!(
+            eye.cmpgt(DVec3::ZERO).all() && eye.cmplt(size).all(),
+            "{camera:?}"
+        );
+        assert!(eye.y > 0.0 && eye.y < 2.0, "{eye}");
+        // Open at the front (+z): rays from its centre leave through it.
+        let open = turned_inwards(box_obj(DVec3::ZERO, size, &["+z"]));
+        let camera = framed(with(open, &table));
+        assert!(camera.eye.z > size.z, "{camera:?}");
+        assert_eq!(camera.fov, FOV);
+    }
+
+    /// Issue 65 point 3: the faces' lean names the up axis where the base
+    /// does not. A bumpy z-up terrain with no flat base stands on z; an
+    /// open-backed mask facing +z (y up) leans along z but its area sits
+    /// at its front, so it keeps y; a Blender header gives way to a
+    /// terrain's lean (Blender's y-up default was changed), and the eye
+    /// stays above the ground.
+    #[test]
+    fn the_faces_lean_names_the_up_axis() {
+        // A 6x6 grid of heights over 10x10 in x and y, bumps up to 0.6.
+        let mut terrain = String::new();
+        let n = 6;
+        for j in 0..n {
+            for i in 0..n {
+                let h = 0.3 * ((i * 7 + j * 3) % 5) as f64 / 2.0;
+                terrain += &format!("v {} {} {h}\n", 2 * i, 2 * j);
+            }
+        }
+        for j in 0..n - 1 {
+            for i in 0..n - 1 {
+                let k = j * n + i + 1;
+                terrain += &format!("f {} {} {} {}\n", k, k + 1, k + n + 1, k + n);
+            }
+        }
+        let camera = framed(terrain.clone());
+        assert_eq!(camera.up, DVec3::Z);
+        assert!(camera.eye.z > camera.lookat.z);
+        let camera = framed(format!("# Blender v2.90.0 OBJ File: ''\n{terrain}"));
+        assert_eq!(camera.up, DVec3::Z);
+        // The mask: a shallow dome bulging towards +z, open at the back.
+        let mut mask = String::new();
+        for j in 0..n {
+            for i in 0..n {
+                let (x, y) = (i as f64 - 2.5, j as f64 - 2.5);
+                mask += &format!("v {x} {y} {}\n", 3.0 - 0.2 * (x * x + y * y));
+            }
+        }
+        for j in 0..n - 1 {
+            for i in 0..n - 1 {
+                let k = j * n + i + 1;
+                mask += &format!("f {} {} {} {}\n", k, k + 1, k + n + 1, k + n);
+            }
+        }
+        let camera = framed(mask);
+        assert_eq!(camera.up, DVec3::Y);
     }
 }
