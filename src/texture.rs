@@ -168,9 +168,9 @@ impl Texture {
         })
     }
 
-    /// A texture made of `texels` (RGBA, top row first), for tests and
-    /// built-in content.
-    pub fn from_texels(name: &str, width: u32, height: u32, texels: Vec<[u8; 4]>) -> Self {
+    /// A texture made of `texels` (RGBA, top row first), for tests.
+    #[cfg(test)]
+    pub(crate) fn from_texels(name: &str, width: u32, height: u32, texels: Vec<[u8; 4]>) -> Self {
         assert_eq!(texels.len(), width as usize * height as usize);
         Self {
             path: PathBuf::from(name),

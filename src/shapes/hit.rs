@@ -3,7 +3,7 @@
 //! file of its own so that the shapes and the [`Shape`](super::Shape) enum
 //! over them all depend on it and not on each other.
 
-use crate::math::{DVec3, Ray};
+use crate::math::{Aabb, DVec3, Ray};
 
 /// Runs `$body` with the axes `(KX, KY, KZ)` of the watertight test's
 /// permutation `$permutation` bound as constants (a vector indexed by a
@@ -100,6 +100,40 @@ impl PreparedRay {
             permutation,
             shear,
         }
+    }
+
+    /// The ray's parameter range inside the box `bounds`, within
+    /// `[0, t_max]`, or `None` if it misses: the slab test (Kay & Kajiya
+    /// 1986), each far parameter passed through `widen_far` (the identity,
+    /// or a margin for boxes stored in lower precision), and components
+    /// treated as parallel (`parallel`) tested as inside their slab or not.
+    /// The octree's root and the BVH's nodes use it.
+    #[inline(always)]
+    pub fn box_range(
+        &self,
+        bounds: &Aabb,
+        t_max: f64,
+        widen_far: impl Fn(f64) -> f64,
+    ) -> Option<(f64, f64)> {
+        let (lo, hi) = (bounds.min.to_array(), bounds.max.to_array());
+        let o = self.ray.origin.to_array();
+        let (mut t0, mut t1) = (0.0f64, t_max);
+        for k in 0..3 {
+            if self.parallel >> k & 1 == 1 {
+                if o[k] < lo[k] || o[k] > hi[k] {
+                    return None;
+                }
+                continue;
+            }
+            let inv = self.inv_dir[k];
+            let (mut near, mut far) = ((lo[k] - o[k]) * inv, (hi[k] - o[k]) * inv);
+            if near > far {
+                std::mem::swap(&mut near, &mut far);
+            }
+            t0 = t0.max(near);
+            t1 = t1.min(widen_far(far));
+        }
+        (t0 <= t1).then_some((t0, t1))
     }
 
     /// The dominant axis of `d`, and whether the direction is negative

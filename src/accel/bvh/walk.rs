@@ -32,29 +32,10 @@ fn widen(t: f64) -> f64 {
 
 impl BvhNode {
     /// Where the ray enters the box within `[0, t_max]`, or `None` if it
-    /// misses: the slab test, with components the ray runs parallel to
-    /// tested as inside their slab or not.
+    /// misses ([`PreparedRay::box_range`], far sides widened by [`SLACK`]).
     #[inline(always)]
     fn entry(&self, ray: &PreparedRay, t_max: f64) -> Option<f64> {
-        let (lo, hi) = (self.bounds.min.to_array(), self.bounds.max.to_array());
-        let o = ray.ray.origin.to_array();
-        let (mut t0, mut t1) = (0.0f64, t_max);
-        for k in 0..3 {
-            if ray.parallel >> k & 1 == 1 {
-                if o[k] < lo[k] || o[k] > hi[k] {
-                    return None;
-                }
-                continue;
-            }
-            let inv = ray.inv_dir[k];
-            let (mut near, mut far) = ((lo[k] - o[k]) * inv, (hi[k] - o[k]) * inv);
-            if near > far {
-                std::mem::swap(&mut near, &mut far);
-            }
-            t0 = t0.max(near);
-            t1 = t1.min(widen(far));
-        }
-        (t0 <= t1).then_some(t0)
+        ray.box_range(&self.bounds, t_max, widen).map(|(t0, _)| t0)
     }
 }
 

@@ -110,35 +110,6 @@ impl Octree {
         }
     }
 
-    /// The ray's parameter range inside the root cell, clipped to
-    /// `[0, t_max]` (`None` if it misses): the slab test, with components
-    /// treated as parallel inside their slab everywhere or nowhere.
-    #[inline(always)]
-    fn root_range(&self, ray: &PreparedRay, t_max: f64) -> Option<(f64, f64)> {
-        let (lo, hi) = (self.bounds.min.to_array(), self.bounds.max.to_array());
-        let o = ray.ray.origin.to_array();
-        let (mut t0, mut t1) = (0.0f64, t_max);
-        for k in 0..3 {
-            if ray.parallel >> k & 1 == 1 {
-                if o[k] < lo[k] || o[k] > hi[k] {
-                    return None;
-                }
-                continue;
-            }
-            let inv = ray.inv_dir[k];
-            let (mut near, mut far) = ((lo[k] - o[k]) * inv, (hi[k] - o[k]) * inv);
-            if near > far {
-                std::mem::swap(&mut near, &mut far);
-            }
-            t0 = t0.max(near);
-            t1 = t1.min(far);
-            if t0 > t1 {
-                return None;
-            }
-        }
-        Some((t0, t1))
-    }
-
     /// The traversal: pops cells front to back until the visitor stops or
     /// nothing further along the ray can matter.
     #[inline(always)]
@@ -154,7 +125,7 @@ impl Octree {
             visitor.counter().walk_end(WalkEnd::MissedOctree);
             return;
         }
-        let Some((t0, t1)) = self.root_range(ray, t_max) else {
+        let Some((t0, t1)) = ray.box_range(&self.bounds, t_max, |t| t) else {
             visitor.counter().walk_end(WalkEnd::MissedOctree);
             return;
         };
