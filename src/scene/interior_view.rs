@@ -23,12 +23,16 @@ use super::model_probe::{ModelProbe, ProbeHit};
 /// Vertical field of view inside, degrees: wider than outside, as a room
 /// surrounds the eye.
 const FOV: f64 = 60.0;
-/// Rays cast from a candidate place.
+/// Rays cast from a place: enough that a doorway or an opening to the sky
+/// shows as a share of them, few enough to survey a grid of places.
 const DIRECTIONS: usize = 96;
 /// Least share of those rays that meet the model for the place to be
-/// enclosed (an atrium open to the sky still is).
+/// enclosed: an atrium open to the sky still is, a room open at one side
+/// is not.
 const ENCLOSED: f64 = 0.85;
-/// Least share of the surfaces met that face the place.
+/// Least share of the surfaces met that face the place: interiors are
+/// modelled facing in throughout, and a model with some faces wound the
+/// other way (a diorama's buildings) is no interior.
 const FACING: f64 = 0.9;
 /// Heights of the eye above the floor tried, as shares of the
 /// floor-to-ceiling height.
@@ -44,7 +48,9 @@ pub(super) fn interior_view(
 ) -> Option<(CameraSpec, DVec3)> {
     let center = 0.5 * bounds.min + 0.5 * bounds.max;
     let extent = bounds.max - bounds.min;
-    let radius = 0.5 * extent.length();
+    // Scaled, so the squares of a 1e200 model do not overflow.
+    let largest = extent.max_element();
+    let radius = 0.5 * largest * (extent / largest).length();
     if !(radius > 0.0 && radius.is_finite()) {
         return None;
     }
@@ -64,10 +70,9 @@ pub(super) fn interior_view(
         return None;
     }
     // Candidate places on a 3x3x3 grid through the middle of the bounds
-    // that are inside. The lowest storey
-    // first (the ground floor, not a gallery), there the most open place
-    // (the longest mean distance to what its rays meet), on a tie the
-    // nearest the centre.
+    // that are inside: the lowest storey first (the ground floor, not a
+    // gallery), there the most open place (the longest mean distance to
+    // what its rays meet), on a tie the first surveyed (the centre's).
     let mut candidates = Vec::new();
     for (storey, f_up) in [0.25, 0.5, 0.75].into_iter().enumerate() {
         for f0 in [0.5, 0.3, 0.7] {
@@ -89,29 +94,19 @@ pub(super) fn interior_view(
     });
     let place = candidates.first()?.1.place;
 
-    // The floor and the ceiling (or the model's top, open to the sky) over
-    // that place.
     let height_of = |p: DVec3| p.dot(up);
     let cast = |from: DVec3, dir: DVec3, stack: &mut WalkStack| {
         probe.closest(Ray::new(from, dir), f64::INFINITY, stack)
     };
-    let (bottom, top) = (
-        height_of(bounds.min).min(height_of(bounds.max)),
-        height_of(bounds.min).max(height_of(bounds.max)),
-    );
-    let floor = cast(place, -up, &mut stack).map_or(bottom, |h| height_of(h.point));
-    let ceiling = cast(place, up, &mut stack).map_or(top, |h| height_of(h.point));
-    let room = ceiling - floor;
-    if !(room > 0.0) {
-        return None;
-    }
+    // Where a ceiling is open to the sky, the model's top stands for it.
+    let top = height_of(bounds.min).max(height_of(bounds.max));
     let at_height = |p: DVec3, height: f64| p + up * (height - height_of(p));
 
     // Along the longest horizontal extent, towards its farther end, from
     // most of the way back to the nearer one. Of the places beside that
-    // line and the two eye heights, the one whose view reaches farthest
-    // (not into a table or a column). The floor is taken again under each
-    // place, for stairs and steps.
+    // line and the two eye heights, the one inside whose view reaches
+    // farthest (not into a table or a column). The floor and ceiling are
+    // taken again under each place, for stairs, steps and arches.
     let (longest, beside) = if extent.dot(across[0].abs()) >= extent.dot(across[1].abs()) {
         (across[0], across[1])
     } else {
@@ -141,14 +136,23 @@ pub(super) fn interior_view(
             } else {
                 (-longest, behind, ahead)
             };
-            // A step of the floor, not a gallery's roof or a pit.
+            // Back only onto a step of the floor (not a gallery's roof or
+            // a pit), at the same share of the room's height there.
             let stepped = standing - look * (0.75 * behind);
-            let eye = match cast(stepped, -up, &mut stack) {
-                Some(h) if (height_of(h.point) - floor).abs() <= 0.1 * room => {
-                    at_height(stepped, height_of(h.point) + share * room)
+            let floor_there = cast(stepped, -up, &mut stack).map(|h| height_of(h.point));
+            let ceiling_there = cast(stepped, up, &mut stack).map_or(top, |h| height_of(h.point));
+            let eye = match floor_there {
+                Some(f) if (f - floor).abs() <= 0.1 * room && ceiling_there > f => {
+                    at_height(stepped, f + share * (ceiling_there - f))
                 }
                 _ => standing,
             };
+            // The eye itself must be inside, not through a doorway or on
+            // a plaza beside the building.
+            if survey(probe, eye, &directions, &mut stack).is_none() {
+                continue;
+            }
+            let ahead = ahead + (standing - eye).dot(look);
             let camera = CameraSpec {
                 eye,
                 lookat: eye + look * (0.5 * ahead).max(1e-6 * radius),
@@ -162,11 +166,11 @@ pub(super) fn interior_view(
             // over the eye), and the shadows fall away from the eye.
             let eye_height = height_of(eye);
             let ahead_of_eye = eye + look * (ahead / 3.0);
-            let ceiling_there =
+            let ceiling_ahead =
                 cast(ahead_of_eye, up, &mut stack).map_or(top, |h| height_of(h.point));
             let light = at_height(
                 ahead_of_eye,
-                eye_height + (ceiling_there - eye_height).max(0.0) * 2.0 / 3.0,
+                eye_height + (ceiling_ahead - eye_height).max(0.0) * 2.0 / 3.0,
             );
             if best.as_ref().is_none_or(|(most, ..)| depth > *most) {
                 best = Some((depth, camera, light));
@@ -174,8 +178,11 @@ pub(super) fn interior_view(
         }
     }
     let (_, camera, light) = best?;
-    (camera.eye.is_finite() && camera.lookat.is_finite() && camera.check().is_ok())
-        .then_some((camera, light))
+    (camera.eye.is_finite()
+        && camera.lookat.is_finite()
+        && light.is_finite()
+        && camera.check().is_ok())
+    .then_some((camera, light))
 }
 
 /// How far a view reaches: the mean distance to what a 12x9 thumbnail's

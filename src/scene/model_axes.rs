@@ -31,8 +31,9 @@ pub(super) const Z_UP: ModelAxes = ModelAxes {
 /// Whether the exporter a header comment names writes +y up by default:
 /// Blender's OBJ exporter (up Y, forward -Z unless changed), 3ds Max's
 /// (guruware's, which flips to y-up), Maya, Cinema 4D and Wings 3D, whose
-/// own axes are y-up. Their files are read y-up whatever their content
-/// suggests (a fence's flat back is no base).
+/// own axes are y-up. Their files are read y-up unless the faces' lean
+/// says otherwise: a fence's flat back is no base, but a terrain exported
+/// with the axes changed still faces up.
 fn exporter_writes_y_up(header: &str) -> bool {
     let header = header.to_ascii_lowercase();
     [
@@ -115,13 +116,12 @@ pub(super) fn model_axes(shapes: &[Shape], bounds: Aabb, header: Option<&str>) -
 /// leans up along +y or +z by at least 0.6 and twice as much as along the
 /// other (a terrain, a floor plan, a street: most of the area faces up; a
 /// floor and a wall of equal size lean as much up as forwards), with the
-/// model's area in the lower
-/// 60 % along that axis (a mask open at the back leans as much along the
-/// way it faces, but its area sits at its front). A smaller lean says
-/// nothing: a room without a ceiling leans up as much as a Cornell box,
-/// open at its front, leans forwards. A model thinner than 2 % of its
-/// size along the axis (a sheet) names none: it may be a floor or a
-/// picture.
+/// model's area in the lower 60 % along that axis (a mask open at the
+/// back leans as much along the way it faces, but its area sits at its
+/// front). A smaller lean says nothing: a room without a ceiling leans up
+/// as much as a Cornell box, open at its front, leans forwards. A model
+/// thinner than 2 % of its size along the axis (a sheet) names none: it
+/// may be a floor or a picture.
 fn upward_lean(shapes: &[Shape], bounds: Aabb) -> Option<ModelAxes> {
     let extent = bounds.max - bounds.min;
     let largest = extent.max_element();
