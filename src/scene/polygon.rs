@@ -70,6 +70,22 @@ pub fn triangulate(vertices: &[DVec3]) -> Result<Vec<[u32; 3]>, PolygonDefect> {
     // size, not its distance from the origin.
     let centroid = vertices.iter().copied().sum::<DVec3>() / vertices.len() as f64;
     let local: Vec<DVec3> = vertices.iter().map(|&v| v - centroid).collect();
+    // Scaled by a power of two to about unit size. That is exact, so every
+    // test below decides as it would unscaled, while its products of up to
+    // four coordinates neither overflow (a polygon 1e150 across) nor
+    // underflow (1e-150 across).
+    let largest = local
+        .iter()
+        .fold(0.0f64, |m, v| m.max(v.abs().max_element()));
+    if !(largest > 0.0 && largest.is_finite()) {
+        return Err(PolygonDefect::ZeroArea);
+    }
+    let exponent = largest.log2().floor() as i32;
+    let (half, rest) = (
+        2f64.powi(-exponent / 2),
+        2f64.powi(-(exponent - exponent / 2)),
+    );
+    let local: Vec<DVec3> = local.iter().map(|&v| v * half * rest).collect();
     // Newell's normal: twice the vector area, pointing to the side from
     // which the vertices run counter-clockwise.
     let mut area_vector = DVec3::ZERO;
@@ -714,6 +730,25 @@ mod tests {
                     "{:?} for a polygon of area {}", defect, expected
                 ),
             }
+        }
+    }
+
+    /// A polygon 1e150 or 1e-150 across is cut as at unit size: the
+    /// tests' products of four coordinates would overflow or underflow
+    /// unscaled (found by taking a test hall to those scales).
+    #[test]
+    fn huge_and_tiny_polygons_are_cut_as_at_unit_size() {
+        let square = [(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 0.5), (0.0, 1.0)];
+        let at = |scale: f64| {
+            let points: Vec<(f64, f64)> = square
+                .iter()
+                .map(|&(x, y)| (x * scale, y * scale))
+                .collect();
+            triangulate(&flat(&points))
+        };
+        let unit = at(1.0).unwrap();
+        for scale in [1e150, 1e-150, 1e300, 1e-300, 3e7] {
+            assert_eq!(at(scale).unwrap(), unit, "scale {scale}");
         }
     }
 }
