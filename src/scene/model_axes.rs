@@ -1,6 +1,6 @@
 //! Which way is up in an OBJ model, which has no up axis of its own: read
-//! from how its faces lean, the exporter its header names, and the flat
-//! base it stands on, in that order.
+//! from how its faces lean, then from the flat base it stands on, weighed
+//! against the exporter its header names.
 
 use crate::math::{Aabb, DVec3};
 use crate::shapes::Shape;
@@ -31,9 +31,8 @@ pub(super) const Z_UP: ModelAxes = ModelAxes {
 /// Whether the exporter a header comment names writes +y up by default:
 /// Blender's OBJ exporter (up Y, forward -Z unless changed), 3ds Max's
 /// (guruware's, which flips to y-up), Maya, Cinema 4D and Wings 3D, whose
-/// own axes are y-up. Their files are read y-up unless the faces' lean
-/// says otherwise: a fence's flat back is no base, but a terrain exported
-/// with the axes changed still faces up.
+/// own axes are y-up. A user can change that default, so the header only
+/// raises the bar a flat base must clear (`model_axes`).
 fn exporter_writes_y_up(header: &str) -> bool {
     let header = header.to_ascii_lowercase();
     [
@@ -48,123 +47,147 @@ fn exporter_writes_y_up(header: &str) -> bool {
     .any(|name| header.contains(name))
 }
 
-/// The up axis the model's content suggests: +z when the model stands on
-/// a flat base at its lowest z (faces perpendicular to z there covering at
-/// least 2 % of its footprint) that has no match at its top (a box or a
-/// slab is flat at both ends and says nothing) and no comparable base at
-/// its lowest y; +y, OBJ's convention, otherwise. A statue's plinth, a
-/// 3D-print's bed face or a building's ground slab is such a base; the
-/// flat butt of a rifle lying along z is not, its muzzle end being as flat.
+/// The least net lean, as a share of the area, that names an up axis
+/// outright: most of the area faces up (a terrain, a street, a floor
+/// plan).
+const STRONG_LEAN: f64 = 0.6;
+/// The least net lean that names an up axis unless the other axis has a
+/// floor and a ceiling: a building open underneath, a room without its
+/// roof or its front walls.
+const WEAK_LEAN: f64 = 0.1;
+/// The share of the footprint a flat base must cover, and the larger share
+/// it must cover when the header names a y-up exporter.
+const BASE: f64 = 0.02;
+const BASE_AGAINST_HEADER: f64 = 0.05;
+
+/// What one pass over the faces gathers along one axis (y or z).
+#[derive(Clone, Copy, Default)]
+struct AlongAxis {
+    /// The area-weighted sum of the unit normals' component.
+    net: f64,
+    /// The area-weighted height of the faces, 0 at the bottom, 1 at the top.
+    moment: f64,
+    /// The area of faces perpendicular to the axis at its low and high end.
+    low: f64,
+    high: f64,
+}
+
+/// The up axis the model's content suggests, +y (OBJ's convention) unless
+/// it says +z. In this order:
 ///
-/// Two things come before the base. First the way the faces lean: floors,
-/// roofs and the ground face up, so a model open to the sky (a room
-/// without its ceiling, a terrain, a street) has more face area turned up
-/// than down, where a closed model's outward faces cancel (`upward_lean`).
-/// Then the exporter named in the header comment, whose default is y-up
-/// (`exporter_writes_y_up`); a user can change that default, which only
-/// the content then shows.
+/// 1. The way the faces lean (`leans_up`). Floors, roofs and the ground
+///    face up, so a model open to the sky or underneath has more face area
+///    turned up than down, where a closed model's outward faces cancel.
+/// 2. A flat base at its lowest z (faces perpendicular to z there covering
+///    at least 2 % of its footprint) that has no match at its top (a box
+///    or a slab is flat at both ends and says nothing) and no comparable
+///    base at its lowest y: a statue's plinth, a 3D-print's bed face, a
+///    building's ground slab. The flat butt of a rifle lying along z is no
+///    base, its muzzle end being as flat. Where the header names an
+///    exporter whose default is y-up (`exporter_writes_y_up`), the base
+///    must cover 5 %: the default weighs against a faint base, while a
+///    clear one shows the default was changed (a scanned drill standing
+///    on its battery).
 pub(super) fn model_axes(shapes: &[Shape], bounds: Aabb, header: Option<&str>) -> ModelAxes {
-    if let Some(axes) = upward_lean(shapes, bounds) {
-        return axes;
-    }
-    if header.is_some_and(exporter_writes_y_up) {
+    let extent = bounds.max - bounds.min;
+    let largest = extent.max_element();
+    if !(largest > 0.0 && largest.is_finite()) {
         return Y_UP;
     }
-    let extent = bounds.max - bounds.min;
-    // Area of faces perpendicular to `axis` lying at its low and high end,
-    // as fractions of the model's footprint across that axis.
-    let flat_ends = |axis: usize| {
-        let across = extent[(axis + 1) % 3] * extent[(axis + 2) % 3];
-        let tolerance = 0.01 * extent[axis];
-        let (mut low, mut high) = (0.0, 0.0);
-        if !(across > 0.0 && across.is_finite()) {
-            return (0.0, 0.0);
+    let (y, z, area) = survey(shapes, bounds);
+    if !(area > 0.0) {
+        return Y_UP;
+    }
+    // The footprint across each axis, in the scaled units of `survey`.
+    let across =
+        |axis: usize| extent[(axis + 1) % 3] * extent[(axis + 2) % 3] / (largest * largest);
+    // A model flat across an axis has no footprint across it: no base.
+    let share = |along: AlongAxis, axis: usize| {
+        let across = across(axis);
+        if across > 0.0 {
+            (along.low / across, along.high / across)
+        } else {
+            (0.0, 0.0)
         }
-        for shape in shapes {
-            let Shape::Triangle(t) = shape else { continue };
-            let [a, b, c] = t.vertices;
-            let normal = (b - a).cross(c - a);
-            let area = 0.5 * normal.length();
-            if !(area.is_finite() && normal[axis].abs() > 0.99 * 2.0 * area) {
-                continue;
-            }
-            let (lo, hi) = (
-                a[axis].min(b[axis]).min(c[axis]),
-                a[axis].max(b[axis]).max(c[axis]),
-            );
-            // A flat model's faces lie at both ends: no base.
-            if hi <= bounds.min[axis] + tolerance {
-                low += area;
-            }
-            if lo >= bounds.max[axis] - tolerance {
-                high += area;
-            }
-        }
-        (low / across, high / across)
     };
-    let (base_z, top_z) = flat_ends(2);
-    let (base_y, _) = flat_ends(1);
-    if base_z >= 0.02 && base_z > 2.0 * top_z && base_z > 2.0 * base_y {
+    let (base_y, top_y) = share(y, 1);
+    let (base_z, top_z) = share(z, 2);
+    let thick = |axis: usize| extent[axis] >= 0.02 * largest;
+    let lean_y = (y.net / area, y.moment / area);
+    let lean_z = (z.net / area, z.moment / area);
+    // A floor and a ceiling across the axis: a room, closed or open at its
+    // front, whose lean along its depth says nothing of up.
+    let roofed = |base: f64, top: f64| base >= 0.5 && top >= 0.5;
+    if thick(2) && leans_up(lean_z, lean_y.0, roofed(base_y, top_y)) {
+        return Z_UP;
+    }
+    if thick(1) && leans_up(lean_y, lean_z.0, roofed(base_z, top_z)) {
+        return Y_UP;
+    }
+    let least_base = if header.is_some_and(exporter_writes_y_up) {
+        BASE_AGAINST_HEADER
+    } else {
+        BASE
+    };
+    if base_z >= least_base && base_z > 2.0 * top_z && base_z > 2.0 * base_y {
         Z_UP
     } else {
         Y_UP
     }
 }
 
-/// The up axis the faces' net lean names, if they name one: the
-/// area-weighted sum of the unit face normals, as a share of the area,
-/// leans up along +y or +z by at least 0.6 and twice as much as along the
-/// other (a terrain, a floor plan, a street: most of the area faces up; a
-/// floor and a wall of equal size lean as much up as forwards), with the
-/// model's area in the lower 60 % along that axis (a mask open at the
-/// back leans as much along the way it faces, but its area sits at its
-/// front). A smaller lean says nothing: a room without a ceiling leans up
-/// as much as a Cornell box, open at its front, leans forwards. A model
-/// thinner than 2 % of its size along the axis (a sheet) names none: it
-/// may be a floor or a picture.
-fn upward_lean(shapes: &[Shape], bounds: Aabb) -> Option<ModelAxes> {
+/// Whether an axis's `(lean, height)` (net lean and where the area sits,
+/// as shares of the area) names it up against the other axis's lean: the
+/// lean is up, twice the other's, and the area sits in the lower 60 % (a
+/// mask open at the back leans the way it faces, but its area sits at its
+/// front). A lean of 0.6 names it outright; one of 0.1 unless the other
+/// axis has a floor and a ceiling (`other_roofed`): a Cornell box, open at
+/// its front, leans forwards as a room without its roof leans up. A floor
+/// and a wall of equal size lean as much up as forwards and name neither.
+fn leans_up((lean, height): (f64, f64), other: f64, other_roofed: bool) -> bool {
+    let clear = lean >= 2.0 * other.abs() && height <= 0.6;
+    clear && (lean >= STRONG_LEAN || (lean >= WEAK_LEAN && !other_roofed))
+}
+
+/// One pass over the triangles: along y and along z, the net lean, the
+/// area-weighted height and the flat ends (faces within 1 % of the extent
+/// of an end, their normals within 8 degrees of the axis), and the total
+/// area. Coordinates are scaled to the model's size first, so the cross
+/// product of a 1e200 model does not overflow.
+fn survey(shapes: &[Shape], bounds: Aabb) -> (AlongAxis, AlongAxis, f64) {
     let extent = bounds.max - bounds.min;
     let largest = extent.max_element();
-    if !(largest > 0.0 && largest.is_finite()) {
-        return None;
-    }
-    let (mut net, mut area_sum, mut moment) = (DVec3::ZERO, 0.0, DVec3::ZERO);
+    let scaled = extent / largest;
+    let mut along = [AlongAxis::default(); 2];
+    let mut area_sum = 0.0;
     for shape in shapes {
         let Shape::Triangle(t) = shape else { continue };
-        let [a, b, c] = t.vertices;
-        // Scaled by the model's size, so the cross product of a 1e200
-        // model does not overflow.
-        let (a, b, c) = (
-            (a - bounds.min) / largest,
-            (b - bounds.min) / largest,
-            (c - bounds.min) / largest,
-        );
+        let [a, b, c] = t.vertices.map(|v| (v - bounds.min) / largest);
         let twice = (b - a).cross(c - a);
         let area = 0.5 * twice.length();
         if !(area > 0.0 && area.is_finite()) {
             continue;
         }
-        net += 0.5 * twice;
         area_sum += area;
-        moment += area * (a + b + c) / 3.0;
+        for (along, axis) in along.iter_mut().zip([1, 2]) {
+            along.net += 0.5 * twice[axis];
+            if scaled[axis] > 0.0 {
+                along.moment += area * (a[axis] + b[axis] + c[axis]) / (3.0 * scaled[axis]);
+            }
+            if twice[axis].abs() > 0.99 * 2.0 * area {
+                let tolerance = 0.01 * scaled[axis];
+                let (lo, hi) = (
+                    a[axis].min(b[axis]).min(c[axis]),
+                    a[axis].max(b[axis]).max(c[axis]),
+                );
+                if hi <= tolerance {
+                    along.low += area;
+                }
+                if lo >= scaled[axis] - tolerance {
+                    along.high += area;
+                }
+            }
+        }
     }
-    if !(area_sum > 0.0) {
-        return None;
-    }
-    let lean = net / area_sum;
-    // Where the area sits along each axis, 0 at the bottom, 1 at the top.
-    let sits = (moment / area_sum) * largest / extent;
-    let names = |axis: usize, other: usize| {
-        extent[axis] >= 0.02 * largest
-            && lean[axis] >= 0.6
-            && lean[axis] >= 2.0 * lean[other].abs()
-            && sits[axis] <= 0.6
-    };
-    if names(2, 1) {
-        Some(Z_UP)
-    } else if names(1, 2) {
-        Some(Y_UP)
-    } else {
-        None
-    }
+    (along[0], along[1], area_sum)
 }
