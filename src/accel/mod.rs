@@ -3,11 +3,13 @@
 //! between equal distances go to the lower shape index in each.
 
 mod bvh;
+mod leaf_visit;
 mod light_buffer;
 mod octree;
 mod planes;
 mod primitives;
 mod walk_log;
+mod wide_walk;
 
 pub use crate::stats::walk_record::{CellVisit, QueryRecord, StepKind, Tested, WalkEnd, WalkStep};
 pub use bvh::{Bvh, BvhStack, BvhStats};

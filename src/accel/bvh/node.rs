@@ -12,3 +12,15 @@ pub(super) struct BvhNode {
     /// References of a leaf; 0 for an interior node.
     pub(super) count: u32,
 }
+
+/// A node is skipped only when the ray enters it this far (relative)
+/// beyond the best hit or the end of the ray: far above the rounding of
+/// the slab test and of hit distances, so a hit that ties with the best
+/// is never skipped.
+const SLACK: f64 = 1e-9;
+
+/// `t` grown by [`SLACK`].
+#[inline(always)]
+pub(super) fn widen(t: f64) -> f64 {
+    t + t.abs() * SLACK
+}

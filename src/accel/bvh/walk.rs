@@ -1,38 +1,69 @@
 //! The traversal: depth first, nearer child first, for the closest hit and
-//! for shadow rays.
+//! for shadow rays, one walk for both: the query is a leaf visitor
+//! (`accel::leaf_visit`), the octree's own.
 
-use super::node::BvhNode;
+use super::node::{BvhNode, widen};
 use super::tree::Bvh;
+use super::wide::LEAF;
+use crate::accel::leaf_visit::{ClosestVisitor, LeafVisitor, OcclusionVisitor};
 use crate::accel::octree::bounds::{Baseline, BoxLanes};
-use crate::accel::primitives::{
-    ClosestHit, Primitives, ShadowCrossings, test_closest, test_occlusion,
-};
+use crate::accel::octree::bounds::{Block, BoxRay};
+use crate::accel::primitives::{ClosestHit, Primitives, ShadowCrossings, test_occlusion};
+use crate::accel::wide_walk::{Opened, WideStack, WideTree, walk_wide};
 use crate::shapes::PreparedRay;
-use crate::stats::{Counter, NoCounts};
-
-/// A node is skipped only when the ray enters it this far (relative)
-/// beyond the best hit or the end of the ray: far above the rounding of
-/// the slab test and of hit distances, so a hit that ties with the best
-/// is never skipped.
-const SLACK: f64 = 1e-9;
+use crate::stats::Counter;
 
 /// The nodes still to visit, with the distance at which the ray enters
 /// each (binary walk, and wide walk). One per tile, so no ray allocates.
 #[derive(Default)]
 pub struct BvhStack {
     binary: Vec<(u32, f64)>,
-    wide: Vec<(u32, f32)>,
+    wide: WideStack,
 }
 
-/// `t` grown by [`SLACK`].
-#[inline(always)]
-fn widen(t: f64) -> f64 {
-    t + t.abs() * SLACK
+/// The BVH's eight-wide nodes (`wide.rs`) as the wide walk takes them: a
+/// lane's child is an entry of its own, a leaf's marked by [`LEAF`].
+impl WideTree for Bvh {
+    const BY_OCTANT: bool = false;
+
+    #[inline(always)]
+    fn box_ray(&self, ray: &PreparedRay) -> BoxRay {
+        BoxRay::relative_to(ray.ray.origin.to_array(), ray.inv_dir, self.wide.corner)
+    }
+
+    #[inline(always)]
+    fn root(&self) -> (&Block, u32) {
+        (&self.wide.root, self.wide.root_entry)
+    }
+
+    #[inline(always)]
+    fn open(&self, at: u32) -> Opened<'_> {
+        if at & LEAF != 0 {
+            let (first, count) = self.wide.leaves[(at & !LEAF) as usize];
+            Opened::Leaf(&self.refs[first as usize..(first + count) as usize])
+        } else {
+            Opened::Interior {
+                boxes: &self.wide.blocks[at as usize],
+                count: self.wide.counts[at as usize] as u32,
+                first: 0,
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn child(&self, node: u32, _: u32, lane: u32) -> u32 {
+        self.wide.children[node as usize][lane as usize]
+    }
+
+    #[inline(always)]
+    fn limit(&self, t: f64) -> f64 {
+        widen(t)
+    }
 }
 
 impl BvhNode {
     /// Where the ray enters the box within `[0, t_max]`, or `None` if it
-    /// misses ([`PreparedRay::box_range`], far sides widened by [`SLACK`]).
+    /// misses ([`PreparedRay::box_range`], far sides grown by [`widen`]).
     #[inline(always)]
     fn entry(&self, ray: &PreparedRay, t_max: f64) -> Option<f64> {
         ray.box_range(&self.bounds, t_max, widen).map(|(t0, _)| t0)
@@ -64,72 +95,12 @@ impl Bvh {
         counter: &mut C,
         lanes: L,
     ) -> Option<ClosestHit> {
-        let mut best = None;
+        let mut visitor = ClosestVisitor::new(prims, ray, t_max, counter);
         for &i in &self.unbounded {
-            test_closest(prims, i, ray, &mut best, t_max, counter);
+            visitor.test(i);
         }
-        let limit = |best: &Option<ClosestHit>| widen(best.map_or(t_max, |b| b.hit.t));
-        let Some(root) = self.nodes.first() else {
-            return best;
-        };
-        if !C::COUNTS && self.has_wide() {
-            let best = std::cell::Cell::new(best);
-            self.wide.walk(
-                ray.ray.origin.to_array(),
-                ray.inv_dir,
-                &mut stack.wide,
-                lanes,
-                || limit(&best.get()),
-                |first, count| {
-                    let mut found = best.get();
-                    let refs = &self.refs[first as usize..(first + count) as usize];
-                    for &shape in refs {
-                        test_closest(prims, shape, ray, &mut found, t_max, &mut NoCounts);
-                    }
-                    best.set(found);
-                    false
-                },
-            );
-            return best.get();
-        }
-        let stack = &mut stack.binary;
-        stack.clear();
-        if let Some(t) = root.entry(ray, limit(&best)) {
-            stack.push((0, t));
-        }
-        while let Some((index, t_enter)) = stack.pop() {
-            if t_enter > limit(&best) {
-                continue;
-            }
-            counter.traversal_step();
-            let node = &self.nodes[index as usize];
-            if node.count > 0 {
-                counter.leaf_visit();
-                let start = node.first_or_second as usize;
-                for &shape in &self.refs[start..start + node.count as usize] {
-                    test_closest(prims, shape, ray, &mut best, t_max, counter);
-                }
-                continue;
-            }
-            let (first, second) = (index + 1, node.first_or_second);
-            let t_max = limit(&best);
-            let near = self.nodes[first as usize].entry(ray, t_max);
-            let far = self.nodes[second as usize].entry(ray, t_max);
-            match (near, far) {
-                (Some(a), Some(b)) if b < a => {
-                    stack.push((first, a));
-                    stack.push((second, b));
-                }
-                (Some(a), Some(b)) => {
-                    stack.push((second, b));
-                    stack.push((first, a));
-                }
-                (Some(a), None) => stack.push((first, a)),
-                (None, Some(b)) => stack.push((second, b)),
-                (None, None) => {}
-            }
-        }
-        best
+        self.walk(ray, stack, &mut visitor, lanes);
+        visitor.best()
     }
 
     /// What a shadow ray meets over `(0, t_max)`, into `found` (cleared
@@ -166,48 +137,77 @@ impl Bvh {
                 return;
             }
         }
+        let mut visitor = OcclusionVisitor::new(prims, ray, t_max, found, counter);
+        self.walk(ray, stack, &mut visitor, lanes);
+    }
+
+    /// Visits the leaves `ray` meets before the visitor's limit until it
+    /// says stop: through the wide nodes when nothing is counted, else
+    /// through the binary nodes, whose steps the counts are of.
+    #[inline(always)]
+    fn walk<V: LeafVisitor, L: BoxLanes>(
+        &self,
+        ray: &PreparedRay,
+        stack: &mut BvhStack,
+        visitor: &mut V,
+        lanes: L,
+    ) {
+        if !<V::C as Counter>::COUNTS && self.has_wide() {
+            walk_wide(self, ray, &mut stack.wide, visitor, lanes);
+        } else {
+            self.walk_binary(ray, &mut stack.binary, visitor, lanes);
+        }
+    }
+
+    /// The binary walk: depth first; a closest-hit query enters the nearer
+    /// child first ([`LeafVisitor::NEAREST_FIRST`]), a shadow query the
+    /// second child first, as stored.
+    #[inline(always)]
+    fn walk_binary<V: LeafVisitor, L: BoxLanes>(
+        &self,
+        ray: &PreparedRay,
+        stack: &mut Vec<(u32, f64)>,
+        visitor: &mut V,
+        lanes: L,
+    ) {
         let Some(root) = self.nodes.first() else {
             return;
         };
-        let limit = widen(t_max);
-        if !C::COUNTS && self.has_wide() {
-            self.wide.walk(
-                ray.ray.origin.to_array(),
-                ray.inv_dir,
-                &mut stack.wide,
-                lanes,
-                || limit,
-                |first, count| {
-                    let refs = &self.refs[first as usize..(first + count) as usize];
-                    refs.iter().any(|&shape| {
-                        test_occlusion(prims, shape, ray, t_max, found, &mut NoCounts)
-                    })
-                },
-            );
-            return;
-        }
-        let stack = &mut stack.binary;
         stack.clear();
-        if root.entry(ray, limit).is_some() {
-            stack.push((0, 0.0));
+        if let Some(t) = root.entry(ray, widen(visitor.limit())) {
+            stack.push((0, t));
         }
-        while let Some((index, _)) = stack.pop() {
-            counter.traversal_step();
+        while let Some((index, t_enter)) = stack.pop() {
+            let limit = widen(visitor.limit());
+            if t_enter > limit {
+                continue;
+            }
+            visitor.counter().traversal_step();
             let node = &self.nodes[index as usize];
             if node.count > 0 {
-                counter.leaf_visit();
+                visitor.counter().leaf_visit();
                 let start = node.first_or_second as usize;
-                for &shape in &self.refs[start..start + node.count as usize] {
-                    if test_occlusion(prims, shape, ray, t_max, found, counter) {
-                        return;
-                    }
+                let refs = &self.refs[start..start + node.count as usize];
+                if visitor.visit_leaf(refs, f64::NEG_INFINITY, lanes) {
+                    return;
                 }
                 continue;
             }
-            for child in [node.first_or_second, index + 1] {
-                if self.nodes[child as usize].entry(ray, limit).is_some() {
-                    stack.push((child, 0.0));
+            let (first, second) = (index + 1, node.first_or_second);
+            let near = self.nodes[first as usize].entry(ray, limit);
+            let far = self.nodes[second as usize].entry(ray, limit);
+            match (near, far) {
+                (Some(a), Some(b)) if V::NEAREST_FIRST && b < a => {
+                    stack.push((first, a));
+                    stack.push((second, b));
                 }
+                (Some(a), Some(b)) => {
+                    stack.push((second, b));
+                    stack.push((first, a));
+                }
+                (Some(a), None) => stack.push((first, a)),
+                (None, Some(b)) => stack.push((second, b)),
+                (None, None) => {}
             }
         }
     }

@@ -4,31 +4,32 @@
 //! and visited nearest entry first, as Embree's 8-wide BVH is (Wald et
 //! al. 2008, "Getting Rid of Packets"). Each wide node takes the
 //! children of the binary nodes below it, opening the largest first,
-//! until it holds eight. Counted queries keep the binary walk, whose
-//! steps are the tree's own.
+//! until it holds eight. The walk is the octree's (`accel::wide_walk`);
+//! counted queries keep the binary walk, whose steps are the tree's own.
 
 use super::node::BvhNode;
-use crate::accel::octree::bounds::{Block, BoxLanes, BoxRay, PAD_RELATIVE, SIDE_RANGE, limit_f32};
+use crate::accel::octree::bounds::{Block, PAD_RELATIVE, SIDE_RANGE};
+use crate::accel::wide_walk::WideStack;
 use crate::math::DVec3;
 
 /// Children per wide node: the lanes of a [`Block`].
 const WIDTH: usize = 8;
 /// A child entry that is a leaf: this bit, and the leaf's index.
-const LEAF: u32 = 1 << 31;
+pub(super) const LEAF: u32 = 1 << 31;
 
 /// The wide nodes: per node, its children's boxes and entries.
 #[derive(Clone, Debug, Default)]
 pub(super) struct WideNodes {
-    blocks: Vec<Block>,
-    children: Vec<[u32; WIDTH]>,
-    counts: Vec<u8>,
+    pub(super) blocks: Vec<Block>,
+    pub(super) children: Vec<[u32; WIDTH]>,
+    pub(super) counts: Vec<u8>,
     /// Per leaf: its first reference and how many.
-    leaves: Vec<(u32, u32)>,
+    pub(super) leaves: Vec<(u32, u32)>,
     /// The root's box (lane 0) and entry.
-    root: Block,
-    root_entry: u32,
+    pub(super) root: Block,
+    pub(super) root_entry: u32,
     /// The corner boxes are relative to.
-    corner: DVec3,
+    pub(super) corner: DVec3,
 }
 
 impl WideNodes {
@@ -48,7 +49,12 @@ impl WideNodes {
         };
         let pad = PAD_RELATIVE * side;
         wide.root.set(0, root.bounds, wide.corner, pad);
-        wide.root_entry = wide.collapse(nodes, 0, pad);
+        let mut depth = 0;
+        wide.root_entry = wide.collapse(nodes, 0, pad, 0, &mut depth);
+        // Deeper than the walk's stack holds: the binary walk serves.
+        if depth > WideStack::MAX_DEPTH {
+            return Self::default();
+        }
         wide
     }
 
@@ -61,8 +67,17 @@ impl WideNodes {
             as u64
     }
 
-    /// The entry of binary node `index`'s subtree.
-    fn collapse(&mut self, nodes: &[BvhNode], index: usize, pad: f64) -> u32 {
+    /// The entry of binary node `index`'s subtree, `level` wide levels
+    /// below the root; `depth` is the deepest level made.
+    fn collapse(
+        &mut self,
+        nodes: &[BvhNode],
+        index: usize,
+        pad: f64,
+        level: usize,
+        depth: &mut usize,
+    ) -> u32 {
+        *depth = (*depth).max(level);
         let node = &nodes[index];
         if node.count > 0 {
             self.leaves.push((node.first_or_second, node.count));
@@ -92,72 +107,9 @@ impl WideNodes {
         self.counts.push(gathered.len() as u8);
         for (lane, &g) in gathered.iter().enumerate() {
             self.blocks[wide].set(lane, nodes[g].bounds, self.corner, pad);
-            let entry = self.collapse(nodes, g, pad);
+            let entry = self.collapse(nodes, g, pad, level + 1, depth);
             self.children[wide][lane] = entry;
         }
         wide as u32
-    }
-
-    /// Visits the leaves whose boxes `origin`/`inv_dir` meets before
-    /// `limit()`, nearest first: `leaf(first, count)` tests their shapes
-    /// and says `true` to stop. `stack` is the caller's scratch.
-    #[inline(always)]
-    pub(super) fn walk<L: BoxLanes>(
-        &self,
-        origin: [f64; 3],
-        inv_dir: [f64; 3],
-        stack: &mut Vec<(u32, f32)>,
-        lanes: L,
-        mut limit: impl FnMut() -> f64,
-        mut leaf: impl FnMut(u32, u32) -> bool,
-    ) {
-        let ray = BoxRay::relative_to(origin, inv_dir, self.corner);
-        let (root, entry) = lanes.hit(&self.root, 1, &ray, limit_f32(limit()));
-        if root == 0 {
-            return;
-        }
-        stack.clear();
-        stack.push((self.root_entry, entry[0]));
-        while let Some((mut at, entry)) = stack.pop() {
-            let bound = limit_f32(limit());
-            if entry > bound {
-                continue;
-            }
-            loop {
-                if at & LEAF != 0 {
-                    let (first, count) = self.leaves[(at & !LEAF) as usize];
-                    if leaf(first, count) {
-                        return;
-                    }
-                    break;
-                }
-                let node = at as usize;
-                let (mut hits, entry) =
-                    lanes.hit(&self.blocks[node], self.counts[node] as u32, &ray, bound);
-                if hits == 0 {
-                    break;
-                }
-                if hits & (hits - 1) == 0 {
-                    at = self.children[node][hits.trailing_zeros() as usize];
-                    continue;
-                }
-                // Farthest first onto the stack, so the nearest is entered next.
-                let base = stack.len();
-                while hits != 0 {
-                    let lane = hits.trailing_zeros() as usize;
-                    hits &= hits - 1;
-                    let child = (self.children[node][lane], entry[lane]);
-                    let mut pos = stack.len();
-                    stack.push(child);
-                    while pos > base && stack[pos - 1].1 < child.1 {
-                        stack[pos] = stack[pos - 1];
-                        pos -= 1;
-                    }
-                    stack[pos] = child;
-                }
-                let Some((next, _)) = stack.pop() else { break };
-                at = next;
-            }
-        }
     }
 }

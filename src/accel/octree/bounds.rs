@@ -1,5 +1,5 @@
 //! The box of what each node holds, for the single-ray walk to test a
-//! node's children eight at a time (`wide_walk.rs`). A cell is a cube,
+//! node's children eight at a time (`accel/wide_walk.rs`). A cell is a cube,
 //! often mostly empty: the box of the shapes it references, clipped to
 //! it, lets a ray skip the empty part the way a BVH node does (Embree's
 //! 8-wide nodes). Boxes are `f32`, relative to the root's lowest corner

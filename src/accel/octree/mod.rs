@@ -25,7 +25,7 @@
 //! non-empty children, which alone are stored and visited. Rays stop as
 //! soon as the best hit lies before the exit of the current leaf. That walk
 //! is the one Havran's measures count; a query that counts nothing takes
-//! the wide walk instead (`wide_walk.rs`): each node's children tested at
+//! the wide walk instead (`accel/wide_walk.rs`): each node's children tested at
 //! once against the boxes of what they hold, with the same answers.
 
 // The eight-wide box test, shared with the BVH's wide nodes.

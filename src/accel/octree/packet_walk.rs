@@ -15,7 +15,8 @@
 
 use super::node::{LEVEL_MASK, Node, child_corner};
 use super::tree::Octree;
-use super::visit::{CellEntry, CellStack, Mailbox, Visitor};
+use super::visit::{CellEntry, CellStack};
+use crate::accel::leaf_visit::{Mailbox, Visitor};
 use crate::accel::primitives::Primitives;
 use crate::limits::MAX_OCTREE_DEPTH;
 use crate::shapes::{PacketHits, RayPacket};

@@ -5,11 +5,10 @@
 use super::bounds::{Baseline, BoxLanes};
 use super::node::{LEVEL_MASK, child_corner};
 use super::tree::Octree;
-use super::visit::{CellEntry, CellStack, LeafVisitor, Mailbox, Visitor};
-use super::wide_walk::WideStack;
-use crate::accel::primitives::{
-    ClosestHit, Primitives, ShadowCrossings, TriangleBatch, test_closest, test_occlusion,
-};
+use super::visit::{CellEntry, CellStack};
+use crate::accel::leaf_visit::{ClosestVisitor, LeafVisitor, OcclusionVisitor, Visitor};
+use crate::accel::primitives::{ClosestHit, Primitives, ShadowCrossings, test_occlusion};
+use crate::accel::wide_walk::{WideStack, walk_wide};
 use crate::limits::MAX_OCTREE_DEPTH;
 use crate::shapes::{PreparedRay, TriangleLanes};
 use crate::stats::Counter;
@@ -40,24 +39,17 @@ impl Octree {
         counter: &mut C,
         lanes: L,
     ) -> Option<ClosestHit> {
-        let mut visitor = ClosestVisitor {
-            prims,
-            ray,
-            best: None,
-            t_max,
-            mailbox: Mailbox::new(),
-            counter,
-        };
+        let mut visitor = ClosestVisitor::new(prims, ray, t_max, counter);
         for &i in &self.unbounded {
-            test_closest(prims, i, ray, &mut visitor.best, t_max, visitor.counter);
+            visitor.test(i);
         }
         if !C::COUNTS && self.has_boxes() {
-            self.walk_wide(ray, &mut stack.wide, &mut visitor, lanes);
+            walk_wide(self, ray, &mut stack.wide, &mut visitor, lanes);
         } else {
             let limit = visitor.limit();
             self.walk(ray, limit, stack, &mut visitor, lanes);
         }
-        visitor.best
+        visitor.best()
     }
 
     /// What a shadow ray meets over `(0, t_max)`, into `found` (cleared
@@ -95,16 +87,9 @@ impl Octree {
                 return;
             }
         }
-        let mut visitor = OcclusionVisitor {
-            prims,
-            ray,
-            t_max,
-            found,
-            mailbox: Mailbox::new(),
-            counter,
-        };
+        let mut visitor = OcclusionVisitor::new(prims, ray, t_max, found, counter);
         if !C::COUNTS && self.has_boxes() {
-            self.walk_wide(ray, &mut stack.wide, &mut visitor, lanes);
+            walk_wide(self, ray, &mut stack.wide, &mut visitor, lanes);
         } else {
             self.walk(ray, t_max, stack, &mut visitor, lanes);
         }
@@ -276,137 +261,4 @@ const STACK_CAPACITY: usize = (3 * MAX_OCTREE_DEPTH as usize + 4).next_power_of_
 pub struct WalkStack {
     cells: CellStack<f64, STACK_CAPACITY>,
     wide: WideStack,
-}
-
-struct ClosestVisitor<'a, C> {
-    prims: &'a Primitives<'a>,
-    ray: &'a PreparedRay,
-    best: Option<ClosestHit>,
-    t_max: f64,
-    mailbox: Mailbox,
-    counter: &'a mut C,
-}
-
-impl<C: Counter> Visitor for ClosestVisitor<'_, C> {
-    type Limit = f64;
-    type C = C;
-    fn counter(&mut self) -> &mut C {
-        self.counter
-    }
-
-    fn limit(&self) -> f64 {
-        self.best.map_or(self.t_max, |b| b.hit.t)
-    }
-}
-
-impl<C: Counter> LeafVisitor for ClosestVisitor<'_, C> {
-    const STOPPED: WalkEnd = WalkEnd::HitInCell;
-    const BEYOND_LIMIT: WalkEnd = WalkEnd::CellsBeyondHit;
-
-    #[inline(always)]
-    fn visit_leaf<L: TriangleLanes>(&mut self, refs: &[u32], t_exit: f64, lanes: L) -> bool {
-        // Uncounted, where the lanes can (triangles are most shapes):
-        // triangles four at a time, the rest one by one, in a loop for
-        // each way (docs/notes/experiments.md compares the forms).
-        if C::COUNTS || !L::FOUR_AT_ONCE {
-            for &i in refs {
-                if !self.mailbox.seen(i) {
-                    test_closest(
-                        self.prims,
-                        i,
-                        self.ray,
-                        &mut self.best,
-                        self.t_max,
-                        self.counter,
-                    );
-                }
-            }
-            return self.best.is_some_and(|b| b.hit.t < t_exit);
-        }
-        let mut batch = TriangleBatch::new();
-        for &i in refs {
-            if self.mailbox.seen(i) {
-                continue;
-            }
-            if let Some(triangle) = self.prims.lane_triangle(i) {
-                if batch.push(i, triangle, false) {
-                    batch.closest(self.prims, self.ray, &mut self.best, self.t_max, lanes);
-                }
-            } else {
-                test_closest(
-                    self.prims,
-                    i,
-                    self.ray,
-                    &mut self.best,
-                    self.t_max,
-                    self.counter,
-                );
-            }
-        }
-        batch.closest(self.prims, self.ray, &mut self.best, self.t_max, lanes);
-        // A hit exactly on the exit face may tie with one in the next cell:
-        // only a hit strictly inside this cell ends the walk.
-        self.best.is_some_and(|b| b.hit.t < t_exit)
-    }
-}
-
-struct OcclusionVisitor<'a, C> {
-    prims: &'a Primitives<'a>,
-    ray: &'a PreparedRay,
-    t_max: f64,
-    found: &'a mut ShadowCrossings,
-    mailbox: Mailbox,
-    counter: &'a mut C,
-}
-
-impl<C: Counter> Visitor for OcclusionVisitor<'_, C> {
-    type Limit = f64;
-    type C = C;
-    fn counter(&mut self) -> &mut C {
-        self.counter
-    }
-
-    fn limit(&self) -> f64 {
-        self.t_max
-    }
-}
-
-impl<C: Counter> LeafVisitor for OcclusionVisitor<'_, C> {
-    const STOPPED: WalkEnd = WalkEnd::Blocked;
-    // Any blocker ends the walk, and the crossings are kept sorted
-    // whatever order they are found in.
-    const NEAREST_FIRST: bool = false;
-    const BEYOND_LIMIT: WalkEnd = WalkEnd::CellsBeyondLight;
-
-    #[inline(always)]
-    fn visit_leaf<L: TriangleLanes>(&mut self, refs: &[u32], _t_exit: f64, lanes: L) -> bool {
-        // Uncounted, where the lanes can (triangles are most shapes):
-        // triangles four at a time, the rest one by one (whichever blocks
-        // first, the ray is blocked).
-        let batching = !C::COUNTS && L::FOUR_AT_ONCE;
-        let mut batch = TriangleBatch::new();
-        for &i in refs {
-            if (L::SKIPS_PLANES && self.prims.left_behind(i)) || self.mailbox.seen(i) {
-                continue;
-            }
-            let blocked =
-                if batching && let Some((triangle, transparent)) = self.prims.shadow_triangle(i) {
-                    batch.push(i, triangle, transparent)
-                        && batch.blocks(self.prims, self.ray, self.t_max, self.found, lanes)
-                } else {
-                    test_occlusion(
-                        self.prims,
-                        i,
-                        self.ray,
-                        self.t_max,
-                        self.found,
-                        self.counter,
-                    )
-                };
-            if blocked {
-                return true;
-            }
-        }
-        batch.blocks(self.prims, self.ray, self.t_max, self.found, lanes)
-    }
 }
