@@ -296,6 +296,68 @@ fn the_layers_of_the_library() {
     }
 }
 
+/// The library drawn by layer: its top-level modules (where those form no
+/// cycle), then every file, bottom layer first.
+fn drawing(graph: &Graph) -> String {
+    let imports: usize = graph.values().map(BTreeSet::len).sum();
+    let mut text = format!("{} files, {imports} imports between them.\n\n", graph.len());
+    let mut modules = Graph::new();
+    for (file, uses) in graph {
+        let top = |f: &str| f.split("::").next().unwrap_or(f).to_string();
+        let entry = modules.entry(top(file)).or_default();
+        entry.extend(uses.iter().map(|u| top(u)).filter(|u| *u != top(file)));
+    }
+    let by_layer = |layers: &BTreeMap<String, usize>| {
+        let top = layers.values().copied().max().unwrap_or(0);
+        (0..=top)
+            .map(|k| {
+                let names: Vec<String> = layers
+                    .iter()
+                    .filter(|(_, l)| **l == k)
+                    .map(|(name, _)| format!("`{name}`"))
+                    .collect();
+                format!("| {k} | {} |\n", names.join(", "))
+            })
+            .collect::<String>()
+    };
+    if find_cycle(&modules).is_none() {
+        text += "| layer | top-level modules |\n|---:|---|\n";
+        text += &by_layer(&layers(&modules));
+        text += "\n";
+    }
+    text += "| layer | files |\n|---:|---|\n";
+    text += &by_layer(&layers(graph));
+    text
+}
+
+/// docs/design.md draws the layers the code has: after a change to the
+/// imports, `GLINT_WRITE_DESIGN=1 cargo test --release --test integration
+/// module_graph` writes the drawing again.
+#[test]
+fn the_design_document_draws_the_layers_the_code_has() {
+    let graph = module_graph(&common::repo_path("src"));
+    assert!(find_cycle(&graph).is_none());
+    let drawn = drawing(&graph);
+    let path = common::repo_path("docs/design.md");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let (open, close) = ("<!-- module-layers -->\n", "<!-- /module-layers -->");
+    let start = text
+        .find(open)
+        .expect("docs/design.md has a module-layers block")
+        + open.len();
+    let end = start + text[start..].find(close).expect("the block is closed");
+    if std::env::var_os("GLINT_WRITE_DESIGN").is_some() {
+        let written = format!("{}{drawn}{}", &text[..start], &text[end..]);
+        std::fs::write(&path, written).unwrap();
+        return;
+    }
+    assert!(
+        text[start..end] == drawn,
+        "docs/design.md's module layers differ from the code's; write them with \
+         GLINT_WRITE_DESIGN=1 cargo test --release --test integration module_graph:\n{drawn}"
+    );
+}
+
 #[test]
 fn only_the_viewer_imports_the_viewer() {
     let graph = module_graph(&common::repo_path("src"));
