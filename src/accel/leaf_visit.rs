@@ -8,7 +8,7 @@
 //! a shape referenced from several octree leaves once per ray.
 
 use crate::accel::primitives::{
-    ClosestHit, Primitives, ShadowCrossings, TriangleBatch, test_closest, test_occlusion,
+    ClosestHit, Primitives, ShadowCrossings, TriangleBatch, shadow_tests, test_closest,
 };
 use crate::shapes::{PreparedRay, TriangleLanes};
 use crate::stats::Counter;
@@ -236,34 +236,20 @@ impl<C: Counter> LeafVisitor for OcclusionVisitor<'_, C> {
 
     #[inline(always)]
     fn visit_leaf<L: TriangleLanes>(&mut self, refs: &[u32], _t_exit: f64, lanes: L) -> bool {
-        // Uncounted, where the lanes can (triangles are most shapes):
-        // triangles four at a time, the rest one by one (whichever blocks
-        // first, the ray is blocked).
-        let batching = !C::COUNTS && L::FOUR_AT_ONCE;
+        // Whichever shape blocks first, the ray is blocked.
         let mut batch = TriangleBatch::new();
-        for &i in refs {
-            if (L::SKIPS_PLANES && self.prims.left_behind(i)) || self.mailbox.seen(i) {
-                continue;
-            }
-            let blocked =
-                if batching && let Some((triangle, transparent)) = self.prims.shadow_triangle(i) {
-                    batch.push(i, triangle, transparent)
-                        && batch.blocks(self.prims, self.ray, self.t_max, self.found, lanes)
-                } else {
-                    test_occlusion(
-                        self.prims,
-                        i,
-                        self.ray,
-                        self.t_max,
-                        self.found,
-                        self.counter,
-                    )
-                };
-            if blocked {
-                return true;
-            }
-        }
-        batch.blocks(self.prims, self.ray, self.t_max, self.found, lanes)
+        let mailbox = &mut self.mailbox;
+        shadow_tests(
+            self.prims,
+            self.ray,
+            self.t_max,
+            self.found,
+            self.counter,
+            &mut batch,
+            refs,
+            |i| mailbox.seen(i),
+            lanes,
+        ) || batch.blocks(self.prims, self.ray, self.t_max, self.found, lanes)
     }
 }
 

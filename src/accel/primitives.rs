@@ -554,23 +554,59 @@ pub(crate) fn occlusion_among_in_lanes<L: TriangleLanes>(
     }
     found.clear();
     let mut batch = TriangleBatch::new();
+    let counter = &mut crate::stats::NoCounts;
     for list in lists {
-        for &i in list {
-            if L::SKIPS_PLANES && prims.left_behind(i) {
-                continue;
-            }
-            let blocked = if let Some((triangle, transparent)) = prims.shadow_triangle(i) {
-                batch.push(i, triangle, transparent)
-                    && batch.blocks(prims, ray, t_max, found, lanes)
-            } else {
-                test_occlusion(prims, i, ray, t_max, found, &mut crate::stats::NoCounts)
-            };
-            if blocked {
-                return;
-            }
+        if shadow_tests(
+            prims,
+            ray,
+            t_max,
+            found,
+            counter,
+            &mut batch,
+            list,
+            |_| false,
+            lanes,
+        ) {
+            return;
         }
     }
     batch.blocks(prims, ray, t_max, found, lanes);
+}
+
+/// A shadow ray's tests of the shapes `refs` (a leaf's, or a light
+/// buffer's list), stopping at the first that blocks it (`true`): shapes
+/// in the plane it leaves ([`TriangleLanes::SKIPS_PLANES`]) and those
+/// `tested` says were tested already are passed over; uncounted, where
+/// the lanes can, triangles wait in `batch` to be tested four at a time
+/// (the caller tests what is left in it at the end).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn shadow_tests<'a, C: Counter, L: TriangleLanes>(
+    prims: &'a Primitives,
+    ray: &PreparedRay,
+    t_max: f64,
+    found: &mut ShadowCrossings,
+    counter: &mut C,
+    batch: &mut TriangleBatch<'a>,
+    refs: &[u32],
+    mut tested: impl FnMut(u32) -> bool,
+    lanes: L,
+) -> bool {
+    let batching = !C::COUNTS && L::FOUR_AT_ONCE;
+    for &i in refs {
+        if (L::SKIPS_PLANES && prims.left_behind(i)) || tested(i) {
+            continue;
+        }
+        let blocked = if batching && let Some((triangle, transparent)) = prims.shadow_triangle(i) {
+            batch.push(i, triangle, transparent) && batch.blocks(prims, ray, t_max, found, lanes)
+        } else {
+            test_occlusion(prims, i, ray, t_max, found, counter)
+        };
+        if blocked {
+            return true;
+        }
+    }
+    false
 }
 
 #[cfg(test)]
