@@ -18,6 +18,9 @@ pub enum StepKind {
     /// An empty octant the ray crosses: counted as entered (Havran's
     /// measure), nothing stored, nothing tested.
     Empty,
+    /// A leaf the ray crosses outside the box of what it holds: counted
+    /// as entered, nothing tested.
+    Missed,
     /// Before the walk, the shapes without bounds (infinite planes),
     /// which no cell holds.
     Unbounded,

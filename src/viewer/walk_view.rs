@@ -93,6 +93,7 @@ fn step_kind_name(kind: StepKind) -> &'static str {
         StepKind::Inner => "inner node",
         StepKind::Leaf => "leaf",
         StepKind::Empty => "empty octant",
+        StepKind::Missed => "leaf, its shapes' box missed",
         StepKind::Unbounded => "unbounded shapes",
     }
 }
@@ -254,7 +255,9 @@ pub fn draw_walk(
         let current = k + 1 == shown.len();
         let stroke = match (current, step.kind) {
             (true, _) => Stroke::new(2.5, Color32::from_rgb(255, 240, 60)),
-            (false, StepKind::Empty) => Stroke::new(1.0, Color32::from_gray(110)),
+            (false, StepKind::Empty | StepKind::Missed) => {
+                Stroke::new(1.0, Color32::from_gray(110))
+            }
             (false, StepKind::Leaf) => Stroke::new(1.0, Color32::from_rgb(90, 160, 255)),
             (false, _) => Stroke::new(1.0, Color32::from_rgb(60, 90, 170)),
         };

@@ -68,7 +68,7 @@ fn walks_go_front_to_back_and_find_what_the_ray_and_brute_force_find() {
         let on = Renderer::new(&scene, &accel, settings(&scene, true)).unwrap();
         let accel = crate::common::accelerator(&scene, &settings(&scene, false), Some(&octree));
         let off = Renderer::new(&scene, &accel, settings(&scene, false)).unwrap();
-        let (mut leaves, mut empties, mut blocked) = (0, 0, 0);
+        let (mut leaves, mut empties, mut missed, mut blocked) = (0, 0, 0, 0);
         for j in (0..SIZE.1).step_by(3) {
             for i in (0..SIZE.0).step_by(3) {
                 let tree = on.ray_tree(i, j);
@@ -101,18 +101,25 @@ fn walks_go_front_to_back_and_find_what_the_ray_and_brute_force_find() {
                     assert_eq!(tested.len() as u64, q.intersection_tests, "{at}");
                     let entered = walk
                         .iter()
-                        .filter(|s| matches!(s.kind, StepKind::Leaf | StepKind::Empty))
+                        .filter(|s| {
+                            matches!(s.kind, StepKind::Leaf | StepKind::Empty | StepKind::Missed)
+                        })
                         .count();
                     assert_eq!(entered as u64, q.leaves_visited, "{at}");
-                    // Leaves front to back.
+                    // Leaves front to back, those whose box the ray misses
+                    // among them; those test nothing.
                     let enters: Vec<f64> = walk
                         .iter()
-                        .filter(|s| s.kind == StepKind::Leaf)
+                        .filter(|s| matches!(s.kind, StepKind::Leaf | StepKind::Missed))
                         .map(|s| s.t_enter.unwrap())
                         .collect();
                     assert!(enters.windows(2).all(|w| w[0] <= w[1]), "{at}: {enters:?}");
                     leaves += enters.len();
                     empties += walk.iter().filter(|s| s.kind == StepKind::Empty).count();
+                    for s in walk.iter().filter(|s| s.kind == StepKind::Missed) {
+                        assert!(s.tested.as_ref().is_none_or(Vec::is_empty), "{at}");
+                        missed += 1;
+                    }
                     for s in walk.iter().filter(|s| s.kind != StepKind::Unbounded) {
                         let (min, max) = (s.min.unwrap(), s.max.unwrap());
                         assert!((0..3).all(|k| min[k] < max[k]), "{at}: a cell has a side");
@@ -161,8 +168,8 @@ fn walks_go_front_to_back_and_find_what_the_ray_and_brute_force_find() {
         assert!(leaves > 50, "{path}: {leaves} leaves");
         if path.ends_with("teapot.nff") {
             assert!(
-                empties > 0 && blocked > 0,
-                "{path}: {empties} empty, {blocked} blocked"
+                empties > 0 && missed > 0 && blocked > 0,
+                "{path}: {empties} empty, {missed} missed, {blocked} blocked"
             );
         }
     }

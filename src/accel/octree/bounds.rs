@@ -74,6 +74,30 @@ impl Block {
         }
     }
 
+    /// Whether `ray` meets lane `lane`'s box before `limit`: one lane of
+    /// [`BoxLanes::hit`], the same operations in the same order.
+    #[inline(always)]
+    pub(super) fn meets(&self, lane: usize, ray: &BoxRay, limit: f32) -> bool {
+        let (mut near, mut far) = (f32::NEG_INFINITY, f32::INFINITY);
+        for k in 0..3 {
+            let (np, fp) = self.near_far(k, ray.negative[k]);
+            let a = (np[lane] - ray.near_origin[k]) * ray.inv[k];
+            let b = (fp[lane] - ray.far_origin[k]) * ray.inv[k];
+            near = if a > near { a } else { near };
+            far = if b < far { b } else { far };
+        }
+        (near <= far * (1.0 + 2.0 * WIDEN)) & (far >= 0.0) & (near <= limit)
+    }
+
+    /// The surface area of lane `lane`'s box (0 for an empty lane).
+    pub(super) fn surface_area(&self, lane: usize) -> f64 {
+        let side = |k: usize| {
+            (self.planes[2 * k + 1][lane] as f64 - self.planes[2 * k][lane] as f64).max(0.0)
+        };
+        let (x, y, z) = (side(0), side(1), side(2));
+        2.0 * (x * y + y * z + z * x)
+    }
+
     pub(crate) const EMPTY: Block = Block {
         planes: [
             [f32::MAX; WIDTH],

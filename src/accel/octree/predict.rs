@@ -5,8 +5,11 @@
 //! (Crofton), which for an octant of a cube is exactly 1/4 per level. So a
 //! ray crossing the root enters, on average, `sum 4^-depth` cells over the
 //! cells it could enter (counted as the walk counts them: nodes and the
-//! empty octants of inner nodes), and tests `sum 4^-depth * references`
-//! over the leaves, plus every unbounded shape.
+//! empty octants of inner nodes), and tests each leaf's references with
+//! the chance that it meets the box of what the leaf holds (the walk tests
+//! nothing in a leaf whose box the ray misses): that box's surface area
+//! over the root's, or `4^-depth` where the tree has no boxes; plus every
+//! unbounded shape.
 //!
 //! View-independent on purpose: rays of every kind (eye, shadow, mirror)
 //! are counted together, and a tree is chosen for all of them, not for
@@ -36,11 +39,14 @@ impl Octree {
         let mut tests = self.unbounded.len() as f64;
         if !self.nodes.is_empty() {
             steps += 1.0;
-            let mut stack = vec![(0u32, 1.0f64)];
-            while let Some((index, weight)) = stack.pop() {
+            let root_area = 6.0 * self.root_cell().side.powi(2);
+            // Per node: the chance of entering its cell, and of meeting the
+            // box of what it holds.
+            let mut stack = vec![(0u32, 1.0f64, 1.0f64)];
+            while let Some((index, weight, held)) = stack.pop() {
                 let node = self.nodes[index as usize];
                 if node.is_leaf() {
-                    tests += weight * node.count() as f64;
+                    tests += held * node.count() as f64;
                     continue;
                 }
                 // Each octant, stored or empty, is entered with a quarter
@@ -48,10 +54,13 @@ impl Octree {
                 let child_weight = 0.25 * weight;
                 steps += 8.0 * child_weight;
                 let mask = node.mask();
-                for c in 0..8 {
-                    if mask >> c & 1 == 1 {
-                        stack.push((node.child(c), child_weight));
-                    }
+                let boxes = self.has_boxes().then(|| self.boxes.children(index));
+                for (lane, c) in (0..8).filter(|c| mask >> c & 1 == 1).enumerate() {
+                    let held = match boxes {
+                        Some(block) => (block.surface_area(lane) / root_area).min(child_weight),
+                        None => child_weight,
+                    };
+                    stack.push((node.child(c), child_weight, held));
                 }
             }
         }

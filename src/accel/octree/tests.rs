@@ -271,27 +271,38 @@ fn rays_in_split_planes_parallel_to_axes_and_through_corners_agree_with_brute_fo
 
 #[test]
 fn predicted_cost_is_what_random_lines_through_the_root_meet() {
-    // Tiny spheres: rays almost never stop at a hit, which the prediction
-    // leaves out, so isotropic random lines (Crofton's measure) that cross
-    // the root must meet, on average, the predicted cells and references.
-    let shapes = sphere_grid(6, 1e-3);
+    // Isotropic random lines (Crofton's measure) that cross the root must
+    // enter, on average, the predicted cells, and test the predicted
+    // references: those of the leaves whose box of what they hold the line
+    // meets. The prediction leaves out rays stopping at a hit, so the
+    // lines are shadow rays through shapes that all let light through;
+    // the spheres sit well inside their leaves' cells (planes of a cube
+    // 5.1 across never come within their radius of a grid point down to
+    // depth 3), so the mailbox saves no test either.
+    let shapes = sphere_grid(6, 0.05);
+    let transparent = vec![true; shapes.len()];
+    let prims = Primitives {
+        transparent: &transparent,
+        ..Primitives::opaque(&shapes)
+    };
     for leaf_size in [1, 4] {
         let params = OctreeParams {
             leaf_size,
-            max_depth: 5,
+            max_depth: 3,
             ..OctreeParams::default()
         };
         let tree = Octree::build(&shapes, params).unwrap();
         let predicted = tree.predicted_cost();
-        let prims = Primitives::opaque(&shapes);
         let (mut counts, mut crossing) = (crate::stats::WorkCounts::default(), 0u32);
         let mut stack = WalkStack::default();
+        let mut found = crate::accel::ShadowCrossings::default();
         for ray in crate::render::random_lines(tree.bounds(), 200_000) {
             let mut one = crate::stats::WorkCounts::default();
-            tree.closest(
+            tree.occlusion(
                 &prims,
                 &PreparedRay::new(ray),
                 f64::INFINITY,
+                &mut found,
                 &mut stack,
                 &mut one,
             );

@@ -2,7 +2,7 @@
 //! Ureña & Lastra (2000), iteratively on a per-thread stack, for the
 //! closest hit and for shadow rays.
 
-use super::bounds::{Baseline, BoxLanes};
+use super::bounds::{Baseline, BoxLanes, BoxRay, limit_f32};
 use super::node::{LEVEL_MASK, child_corner};
 use super::tree::Octree;
 use super::visit::{CellEntry, CellStack};
@@ -116,6 +116,12 @@ impl Octree {
         };
         let o = ray.ray.origin.to_array();
         let inv = ray.inv_dir;
+        // The boxes of what the children hold, where the tree has them: a
+        // child whose box the ray misses is entered but holds nothing for
+        // it.
+        let held = self
+            .has_boxes()
+            .then(|| BoxRay::new(ray, &self.root_cell()));
         let entries = stack.cells.entries();
         entries[0] = CellEntry {
             min: self.bounds.min.to_array(),
@@ -136,20 +142,28 @@ impl Octree {
             }
             visitor.counter().traversal_step();
             let node = self.nodes[e.node as usize];
+            let level = e.level & !MISSED;
             let side = |level: u32| self.sides[level as usize & LEVEL_MASK];
             let visit = |kind| CellVisit {
                 kind,
-                depth: e.level,
+                depth: level,
                 min: e.min,
-                side: side(e.level),
+                side: side(level),
                 t_enter: e.t0,
                 t_exit: e.t1,
             };
             if node.is_leaf() {
                 visitor.counter().leaf_visit();
-                visitor.counter().cell(|| visit(StepKind::Leaf));
-                let first = node.first as usize;
-                let refs = &self.refs[first..first + node.count() as usize];
+                // A leaf whose box the ray misses tests nothing, but ends the
+                // walk as any leaf does (a hit found earlier may lie in it).
+                let refs = if e.level & MISSED != 0 {
+                    visitor.counter().cell(|| visit(StepKind::Missed));
+                    &[]
+                } else {
+                    visitor.counter().cell(|| visit(StepKind::Leaf));
+                    let first = node.first as usize;
+                    &self.refs[first..first + node.count() as usize]
+                };
                 if visitor.visit_leaf(refs, e.t1, lanes) {
                     visitor.counter().walk_end(V::STOPPED);
                     return;
@@ -159,7 +173,7 @@ impl Octree {
             visitor.counter().cell(|| visit(StepKind::Inner));
             // The children's side: the cell's half, exactly as the build
             // halves it.
-            let h = side(e.level + 1);
+            let h = side(level + 1);
             let mid = [e.min[0] + h, e.min[1] + h, e.min[2] + h];
             // Parameters of the three mid-planes, and the octant entered at
             // t0: on a plane's upper side once it is crossed going up, or
@@ -215,9 +229,13 @@ impl Octree {
             times[n + 1] = e.t1;
             // Farthest first, so the nearest is popped next. Empty octants
             // are counted as entered leaves (Havran's measures) but cost
-            // nothing else.
+            // nothing else. A leaf whose box of what it holds (the box the
+            // wide walk tests, `bounds.rs`) the ray misses is marked: none
+            // of its shapes can meet the ray, so it is entered and tests
+            // nothing (the cells entered stay Havran's).
             let limit = visitor.limit();
             let mask = node.mask();
+            let boxes = held.as_ref().map(|ray| (self.boxes.children(e.node), ray));
             for i in (0..=n).rev() {
                 let c = children[i];
                 let min = child_corner(e.min, mid, c);
@@ -227,7 +245,7 @@ impl Octree {
                         visitor.counter().leaf_visit();
                         visitor.counter().cell(|| CellVisit {
                             kind: StepKind::Empty,
-                            depth: e.level + 1,
+                            depth: level + 1,
                             min,
                             side: h,
                             t_enter: times[i],
@@ -236,12 +254,24 @@ impl Octree {
                     }
                     continue;
                 }
+                let child = node.child(c);
+                let lane = (mask & ((1 << c) - 1)).count_ones() as usize;
+                let missed = match boxes {
+                    Some((block, ray)) if self.nodes[child as usize].is_leaf() => {
+                        if block.meets(lane, ray, limit_f32(limit)) {
+                            0
+                        } else {
+                            MISSED
+                        }
+                    }
+                    _ => 0,
+                };
                 entries[top & (STACK_CAPACITY - 1)] = CellEntry {
                     min,
                     t0: times[i],
                     t1: times[i + 1],
-                    node: node.child(c),
-                    level: e.level + 1,
+                    node: child,
+                    level: (level + 1) | missed,
                 };
                 top += 1;
             }
@@ -249,6 +279,9 @@ impl Octree {
         visitor.counter().walk_end(WalkEnd::LeftOctree);
     }
 }
+
+/// A cell's level with this bit: the ray misses the box of what it holds.
+const MISSED: u32 = 1 << 31;
 
 /// Room on the traversal stack: each level leaves at most three siblings
 /// waiting, plus the cell being entered (a power of two, so indices are
