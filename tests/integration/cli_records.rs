@@ -190,6 +190,7 @@ fn a_scene_too_large_to_embed_is_recorded_by_path_and_hash() {
 /// predicted from a sample of its rays is least (glint's suggestion, also
 /// `suggested_from_rays`), the tree-alone model's pick as
 /// `suggested_from_tree`, and the measured best as `fastest`: one row each.
+/// The suggested and the fastest carry `timed_again_s` when they differ.
 #[test]
 fn a_sweep_suggests_what_its_ray_sample_predicts_is_fastest() {
     let scene = common::repo_path("scenes/spd/tetra.nff");
@@ -238,5 +239,14 @@ fn a_sweep_suggests_what_its_ray_sample_predicts_is_fastest() {
     assert_eq!(marked("suggested"), least("predicted_from_rays"));
     assert_eq!(marked("suggested_from_rays"), marked("suggested"));
     assert_eq!(marked("suggested_from_tree"), least("predicted"));
-    marked("fastest");
+    let (suggested, fastest) = (marked("suggested"), marked("fastest"));
+    // Where they differ, both are timed again side by side; no other row is.
+    for (i, row) in rows.iter().enumerate() {
+        let again = &row["timed_again_s"];
+        if suggested != fastest && (i == suggested || i == fastest) {
+            assert!(again.as_f64().is_some_and(|t| t > 0.0), "row {i}: {again}");
+        } else {
+            assert!(again.is_null(), "row {i}: {again}");
+        }
+    }
 }
