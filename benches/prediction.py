@@ -79,14 +79,18 @@ for source, field in [("From the tree alone", "predicted"), ("From a sample of t
 print()
 total = lambda r: r["build_s"] + r["render_s"]
 describe = lambda r: f"depth {r['octree_params']['max_depth']}, leaf {r['octree_params']['leaf_size']}"
-print("| scene | fastest (s) | suggested from rays | (s) | x fastest | suggested from the tree | (s) | x fastest |")
-print("|---|---:|---|---:|---:|---|---:|---:|")
+print("| scene | fastest (s) | suggested from rays | (s) | x fastest | side by side | suggested from the tree | (s) | x fastest |")
+print("|---|---:|---|---:|---:|---:|---|---:|---:|")
 for scene in dict.fromkeys(r["scene"] for r in rows):
     mine = [r for r in rows if r["scene"] == scene]
     f = next(r for r in mine if r["fastest"])
     s = next(r for r in mine if r["suggested_from_rays"])
     t = next(r for r in mine if r["suggested_from_tree"])
+    # The sweep's own side-by-side timing of the two (sweeps since
+    # 2026-11-30), where they differ.
+    again = s.get("timed_again_s"), f.get("timed_again_s")
+    side = "%.2f" % (again[0] / again[1]) if s is not f and None not in again else ("1.00" if s is f else "")
     print(
-        f"| {name(f)} | {total(f):.3f} | {describe(s)} | {total(s):.3f} | {total(s) / total(f):.2f} "
+        f"| {name(f)} | {total(f):.3f} | {describe(s)} | {total(s):.3f} | {total(s) / total(f):.2f} | {side} "
         f"| {describe(t)} | {total(t):.3f} | {total(t) / total(f):.2f} |"
     )
