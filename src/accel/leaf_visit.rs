@@ -112,6 +112,7 @@ impl<'a, C: Counter> ClosestVisitor<'a, C> {
 
     /// Tests shape `index` (one the walk does not reach, such as an
     /// unbounded plane) as a leaf's shape is tested.
+    #[inline(always)]
     pub(crate) fn test(&mut self, index: u32) {
         test_closest(
             self.prims,
@@ -148,14 +149,7 @@ impl<C: Counter> LeafVisitor for ClosestVisitor<'_, C> {
         if C::COUNTS || !L::FOUR_AT_ONCE {
             for &i in refs {
                 if !self.mailbox.seen(i) {
-                    test_closest(
-                        self.prims,
-                        i,
-                        self.ray,
-                        &mut self.best,
-                        self.t_max,
-                        self.counter,
-                    );
+                    self.test(i);
                 }
             }
             return self.best.is_some_and(|b| b.hit.t < t_exit);
@@ -170,14 +164,7 @@ impl<C: Counter> LeafVisitor for ClosestVisitor<'_, C> {
                     batch.closest(self.prims, self.ray, &mut self.best, self.t_max, lanes);
                 }
             } else {
-                test_closest(
-                    self.prims,
-                    i,
-                    self.ray,
-                    &mut self.best,
-                    self.t_max,
-                    self.counter,
-                );
+                self.test(i);
             }
         }
         batch.closest(self.prims, self.ray, &mut self.best, self.t_max, lanes);
